@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Installs everything ibrod needs on a fresh Debian (bookworm) machine. Idempotent: packages that
+# are already present are left alone. Run as root (or through sudo).
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build pkg-config git
+  libfftw3-dev          # FFTs of the periodic fluid grid (with libfftw3 threads)
+  libeigen3-dev         # small vectors, rotations, quaternions
+  libtomlplusplus-dev   # TOML configs
+  libcli11-dev          # command line
+  libgtest-dev libgmock-dev libbenchmark-dev   # tests and micro-benchmarks
+  libhdf5-dev           # H5MD trajectories
+  python3 python3-numpy python3-matplotlib python3-h5py   # analysis and plots
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages already installed"
+  exit 0
+fi
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+echo "install-deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -q
+$SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"

@@ -1,0 +1,56 @@
+#pragma once
+// Generalized immersed-boundary coupling (MODEL §3 (2.9–2.16), §4): spreading of point forces and
+// torques to the grid and interpolation of velocity and angular velocity back to the points,
+// with the smoothed delta δ_c(x) = c⁻³ φ(x₁/c) φ(x₂/c) φ(x₃/c), Peskin's 4-point φ, c = m·h.
+// Knows the grid and a list of points only (no rods).
+//
+// Spreading, for point forces F_k (g Å s⁻²) and point torques T_k (g Å² s⁻²) at X_k:
+//   f(x) += Σ_k F_k δ_c(x − X_k) + ½ curl_h[Σ_k T_k δ_c(x − X_k)]
+// Interpolation, from velocity u on the grid:
+//   U_k = Σ_x u(x) δ_c(x − X_k) h³,   W_k = ½ Σ_x (curl_h u)(x) δ_c(x − X_k) h³
+// curl_h is the central-difference curl, which is symmetric on the periodic grid, so the two are
+// exactly adjoint: Σ_x f·u h³ = Σ_k (F_k·U_k + T_k·W_k). Points may lie anywhere (positions are
+// kept unwrapped; the grid index is wrapped periodically).
+#include <array>
+#include <span>
+
+#include "core/grid.hpp"
+#include "core/types.hpp"
+
+namespace ibrod::ib {
+
+/// Peskin's 4-point function φ(r) (MODEL (2.14)); support |r| < 2, Σ_j φ(r − j) = 1,
+/// Σ_j (r − j) φ(r − j) = 0, Σ_j φ(r − j)² = 3/8.
+double phi4(double r);
+
+/// δ_c(x) with c = m·h: c⁻³ φ(x₁/c) φ(x₂/c) φ(x₃/c), Å⁻³.
+double delta(const Vec3& x, double c);
+
+class Coupler {
+ public:
+  /// kernel_width m: c = m·h, a positive integer.
+  Coupler(const GridSpec& grid, int kernel_width);
+
+  const GridSpec& grid() const { return grid_; }
+  int kernel_width() const { return m_; }
+  double c() const { return m_ * grid_.h(); }
+  /// grid points per dimension that one point touches when spreading (support of φ plus the
+  /// one-point halo of the curl): 4m + 2
+  int stencil() const { return 4 * m_ + 2; }
+
+  /// Accumulates (+=) the force density of point forces F and torques T at X into f
+  /// (g Å⁻² s⁻²). T may be empty (no torques).
+  void spread(std::span<const Vec3> X, std::span<const Vec3> F, std::span<const Vec3> T,
+              std::array<double*, 3> f) const;
+
+  /// Overwrites U (Å s⁻¹) and W (s⁻¹) with the interpolated velocity and angular velocity at X.
+  /// W may be empty (not computed).
+  void interpolate(std::span<const Vec3> X, std::array<const double*, 3> u, std::span<Vec3> U,
+                   std::span<Vec3> W) const;
+
+ private:
+  GridSpec grid_;
+  int m_;
+};
+
+}  // namespace ibrod::ib

@@ -1,0 +1,71 @@
+#pragma once
+// The special Cosserat rod of MODEL §3 (2.5–2.8, 2.13) discretised as in MODEL §4: a closed rod of
+// n points X_k with orthonormal triads D_k = [D¹ D² D³] (columns), spacing Δs along the rod.
+// Internal force F and moment N live at half points k+½ with the half-point triad
+// D_{k+½} = √A D_k, A = D_{k+1} D_kᵀ (principal square root: half the angle about the same axis).
+#include <span>
+#include <vector>
+
+#include "core/types.hpp"
+
+namespace ibrod::rod {
+
+struct RodParams {
+  int n = 600;                            ///< number of rod points (= base pairs)
+  double ds = 3.4;                        ///< Δs, Å (rise per base pair)
+  Vec3 a{1.3e5, 1.3e5, 1.82e5};           ///< a1, a2 (bending), a3 (twist), g Å³ s⁻²
+  Vec3 b{5e3, 5e3, 5e3};                  ///< b1, b2 (shear), b3 (stretch), g Å s⁻²
+  Vec3 omega0{0.0, 0.0, 0.0};             ///< intrinsic curvatures Ω¹₀, Ω²₀ and twist Ω³₀, Å⁻¹
+};
+
+struct RodState {
+  std::vector<Vec3> X;  ///< [n] axis positions, Å (unwrapped: never folded into the box)
+  std::vector<Mat3> D;  ///< [n] triads, columns D¹, D², D³ (orthonormal, right-handed)
+  int size() const { return int(X.size()); }
+};
+
+/// Elastic energy split as the diagnostics report it, g Å² s⁻².
+struct ElasticEnergy {
+  double bend = 0;     ///< (Δs/2) Σ a1 (Ω¹−Ω¹₀)² + a2 (Ω²−Ω²₀)²
+  double twist = 0;    ///< (Δs/2) Σ a3 (Ω³−Ω³₀)²
+  double stretch = 0;  ///< (Δs/2) Σ b1 Γ₁² + b2 Γ₂² + b3 Γ₃²  (shear and stretch)
+  double total() const { return bend + twist + stretch; }
+};
+
+/// Scratch for elastic_forces (half-point quantities), sized once; reused every step.
+struct RodWork {
+  std::vector<Mat3> Dh;  ///< [n] half-point triads D_{k+½}
+  std::vector<Vec3> Fh;  ///< [n] internal force F_{k+½}, lab frame, g Å s⁻²
+  std::vector<Vec3> Nh;  ///< [n] internal moment N_{k+½}, lab frame, g Å² s⁻²
+  std::vector<Vec3> Xp;  ///< [n] X′_{k+½} = (X_{k+1} − X_k)/Δs
+  void resize(int n) { Dh.resize(n); Fh.resize(n); Nh.resize(n); Xp.resize(n); }
+};
+
+/// Half-point triad √(D_{k+1} D_kᵀ) D_k (principal square root). Exposed for tests.
+Mat3 half_point_triad(const Mat3& Dk, const Mat3& Dk1);
+
+/// Elastic point forces and torques that the rod applies to the fluid (MODEL §4 step 4):
+///   F_k += Δs f_k = F_{k+½} − F_{k−½}              (g Å s⁻²)
+///   T_k += Δs n_k = N_{k+½} − N_{k−½} + (Δs/2)[X′_{k+½}×F_{k+½} + X′_{k−½}×F_{k−½}]  (g Å² s⁻²)
+/// Accumulates (+=) into F and T ([n] each). Returns the elastic energy E_h.
+/// F is exactly −∂E_h/∂X_k; T matches the negative rotation gradient of E_h to O(Δs²) relative.
+ElasticEnergy elastic_forces(const RodParams& p, const RodState& s, RodWork& w, std::span<Vec3> F,
+                             std::span<Vec3> T);
+
+/// The discrete elastic energy E_h alone (MODEL §4), g Å² s⁻².
+ElasticEnergy elastic_energy(const RodParams& p, const RodState& s);
+
+/// Explicit rod update of MODEL §4: X_k += dt U_k; D_k ← R(dt W_k) D_k (Rodrigues).
+void advance(RodState& s, std::span<const Vec3> U, std::span<const Vec3> W, double dt);
+
+/// Initial condition of MODEL §5: the twisted circle of radius r0 = n Δs / 2π in the z = 0 plane,
+/// centred at `center`, excess link ΔLk, twist perturbation g(s) = Σ_m eps[m−1] sin(m s / r0).
+/// sin β = −a3 ΔLk / (b1 r0² + a3 − a1).
+struct CircleParams {
+  int excess_link = 6;
+  std::vector<double> perturbation{1.0};  ///< ε_m for m = 1, 2, … (radians)
+  Vec3 center{0.0, 0.0, 0.0};             ///< Å
+};
+RodState twisted_circle(const RodParams& p, const CircleParams& c);
+
+}  // namespace ibrod::rod
