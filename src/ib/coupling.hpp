@@ -13,6 +13,7 @@
 // kept unwrapped; the grid index is wrapped periodically).
 #include <array>
 #include <span>
+#include <vector>
 
 #include "core/grid.hpp"
 #include "core/types.hpp"
@@ -26,9 +27,18 @@ double phi4(double r);
 /// δ_c(x) with c = m·h: c⁻³ φ(x₁/c) φ(x₂/c) φ(x₃/c), Å⁻³.
 double delta(const Vec3& x, double c);
 
+/// Spreading and interpolation for one grid and kernel width. Copyable and without mutable
+/// state, so its const member functions may be called concurrently. Neither spread() nor
+/// interpolate() allocates. Both run OpenMP-parallel (see spread() for how it avoids races) and
+/// give bitwise the same result for any number of threads.
 class Coupler {
  public:
-  /// kernel_width m: c = m·h, a positive integer.
+  /// largest kernel width m accepted (fixed-size stencil arrays: 4m + 2 ≤ 34 points)
+  static constexpr int kMaxKernelWidth = 8;
+
+  /// kernel_width m: c = m·h, a positive integer. Throws std::invalid_argument for m < 1,
+  /// m > kMaxKernelWidth, 4m + 2 > grid.n (the stencil would overlap its own periodic image) or
+  /// a grid with L ≤ 0.
   Coupler(const GridSpec& grid, int kernel_width);
 
   const GridSpec& grid() const { return grid_; }
@@ -39,18 +49,27 @@ class Coupler {
   int stencil() const { return 4 * m_ + 2; }
 
   /// Accumulates (+=) the force density of point forces F and torques T at X into f
-  /// (g Å⁻² s⁻²). T may be empty (no torques).
+  /// (g Å⁻² s⁻²). T may be empty (no torques). f: three distinct, non-overlapping arrays of
+  /// grid().size() values, layout GridSpec::index. Throws std::invalid_argument if F (or a
+  /// non-empty T) differs in size from X, ibrod::RunError if a position is not finite or absurdly
+  /// far out (|X_d| > 2⁴⁰ h).
+  /// Race-free in parallel: the x axis is cut into an even number of slabs at least 4m + 2 wide,
+  /// so a point's stencil touches only its own slab and the next; even slabs are done in
+  /// parallel, then odd ones. Each grid value thus receives its contributions in a fixed order.
   void spread(std::span<const Vec3> X, std::span<const Vec3> F, std::span<const Vec3> T,
               std::array<double*, 3> f) const;
 
   /// Overwrites U (Å s⁻¹) and W (s⁻¹) with the interpolated velocity and angular velocity at X.
-  /// W may be empty (not computed).
+  /// W may be empty (not computed). u: three arrays of grid().size() values. Throws as spread()
+  /// (U, and W unless empty, must have X's size).
   void interpolate(std::span<const Vec3> X, std::array<const double*, 3> u, std::span<Vec3> U,
                    std::span<Vec3> W) const;
 
  private:
   GridSpec grid_;
   int m_;
+  int nslabs_;                 ///< x slabs for race-free parallel spreading (1 or even)
+  std::vector<int> slab_of_;   ///< [n] slab of each x index
 };
 
 }  // namespace ibrod::ib

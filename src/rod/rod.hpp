@@ -38,7 +38,8 @@ struct RodWork {
   std::vector<Vec3> Fh;  ///< [n] internal force F_{k+½}, lab frame, g Å s⁻²
   std::vector<Vec3> Nh;  ///< [n] internal moment N_{k+½}, lab frame, g Å² s⁻²
   std::vector<Vec3> Xp;  ///< [n] X′_{k+½} = (X_{k+1} − X_k)/Δs
-  void resize(int n) { Dh.resize(n); Fh.resize(n); Nh.resize(n); Xp.resize(n); }
+  std::vector<Vec3> Eh;  ///< [n] (bend, twist, stretch) energy of half point k+½, g Å² s⁻²
+  void resize(int n) { Dh.resize(n); Fh.resize(n); Nh.resize(n); Xp.resize(n); Eh.resize(n); }
 };
 
 /// Half-point triad √(D_{k+1} D_kᵀ) D_k (principal square root). Exposed for tests.
@@ -47,7 +48,10 @@ Mat3 half_point_triad(const Mat3& Dk, const Mat3& Dk1);
 /// Elastic point forces and torques that the rod applies to the fluid (MODEL §4 step 4):
 ///   F_k += Δs f_k = F_{k+½} − F_{k−½}              (g Å s⁻²)
 ///   T_k += Δs n_k = N_{k+½} − N_{k−½} + (Δs/2)[X′_{k+½}×F_{k+½} + X′_{k−½}×F_{k−½}]  (g Å² s⁻²)
-/// Accumulates (+=) into F and T ([n] each). Returns the elastic energy E_h.
+/// Accumulates (+=) into F and T ([n] each). Returns the elastic energy E_h (summed in index order,
+/// so it does not depend on the thread count and equals elastic_energy() exactly).
+/// Resizes w if its size is not n (allocation only then). Throws std::invalid_argument if the
+/// sizes of s.D, F or T differ from n.
 /// F is exactly −∂E_h/∂X_k; T matches the negative rotation gradient of E_h to O(Δs²) relative.
 ElasticEnergy elastic_forces(const RodParams& p, const RodState& s, RodWork& w, std::span<Vec3> F,
                              std::span<Vec3> T);
@@ -60,7 +64,9 @@ void advance(RodState& s, std::span<const Vec3> U, std::span<const Vec3> W, doub
 
 /// Initial condition of MODEL §5: the twisted circle of radius r0 = n Δs / 2π in the z = 0 plane,
 /// centred at `center`, excess link ΔLk, twist perturbation g(s) = Σ_m eps[m−1] sin(m s / r0).
-/// sin β = −a3 ΔLk / (b1 r0² + a3 − a1).
+/// sin β = −a3 ΔLk / (b1 r0² + a3 − a1). Uses p.n, p.ds, a1, a3, b1; an equilibrium (to O(Δs²))
+/// only for ε = 0, a1 = a2, b1 = b2 = b3 and zero intrinsic strains. Throws ConfigError for
+/// n < 3, ds ≤ 0 or |sin β| > 1.
 struct CircleParams {
   int excess_link = 6;
   std::vector<double> perturbation{1.0};  ///< ε_m for m = 1, 2, … (radians)

@@ -1,0 +1,52 @@
+#include "integrate/stepper.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+
+namespace ibrod::integrate {
+
+namespace {
+// Every OpenMP loop of the step (rod, coupling, pair forces) runs on the configured thread count;
+// the fluid passes its own count to FFTW and its loops.
+void set_threads(int threads) {
+  if (threads > 0) omp_set_num_threads(threads);
+}
+}  // namespace
+
+Stepper::Stepper(const StepperParams& p)
+    : p_((set_threads(p.threads), p)),
+      fluid_(std::make_unique<fluid::FluidSolver>(p.grid, p.fluid, p.threads, p.plan_measure)),
+      coupler_(p.grid, p.kernel_width),
+      electro_(p.electro, p.rod.n),
+      steric_(p.steric, p.rod.n) {
+  const int n = p.rod.n;
+  work_.resize(n);
+  F_.resize(n);
+  T_.resize(n);
+  U_.resize(n);
+  W_.resize(n);
+}
+
+StepEnergies Stepper::compute_forces(const rod::RodState& s) {
+  std::fill(F_.begin(), F_.end(), Vec3::Zero());
+  std::fill(T_.begin(), T_.end(), Vec3::Zero());
+  StepEnergies e;
+  e.elastic = rod::elastic_forces(p_.rod, s, work_, F_, T_);
+  // MODEL §3 sign convention: −∂E/∂X of every non-elastic potential goes to the fluid unchanged.
+  if (p_.electro.enabled) e.electro = electro_.accumulate(s.X, F_);
+  if (p_.steric.enabled) e.steric = steric_.accumulate(s.X, F_);
+  return e;
+}
+
+void Stepper::step(rod::RodState& s) {
+  last_ = compute_forces(s);
+  fluid_->zero_force();
+  coupler_.spread(s.X, F_, T_, fluid_->force());
+  fluid_->step();
+  const fluid::FluidSolver& fl = *fluid_;
+  coupler_.interpolate(s.X, fl.velocity(), U_, W_);
+  rod::advance(s, U_, W_, p_.fluid.dt);
+}
+
+}  // namespace ibrod::integrate

@@ -1,0 +1,418 @@
+#include "io/config.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <numbers>
+#include <sstream>
+
+#include <toml++/toml.h>
+
+#include "core/error.hpp"
+#include "core/units.hpp"
+#include "interactions/interactions.hpp"
+
+namespace ibrod::io {
+
+Config::Config()
+    : electrostatics_cutoff_debye(interactions::kDefaultCutoffDebye),
+      steric_stiffness_kT_A2(interactions::kDefaultStericStiffness / units::kT(300.0)) {}
+
+namespace {
+
+std::string show(const toml::node& n) {
+  std::ostringstream os;
+  n.visit([&](auto&& v) { os << v; });
+  return os.str();
+}
+
+std::string fmt(double v) {
+  std::ostringstream os;
+  os.precision(12);
+  os << v;
+  return os.str();
+}
+
+[[noreturn]] void bad(const std::string& key, const std::string& value, const std::string& allowed) {
+  throw ConfigError("config: " + key + " = " + value + " is invalid: expected " + allowed);
+}
+
+// One config key: how to read it from TOML into Config, and how to write it back.
+struct Key {
+  std::string name;  // "section.key"
+  std::string help;  // unit and meaning
+  std::function<void(Config&, const toml::node&)> set;
+  std::function<void(const Config&, toml::table&)> put;  // into its section table
+  std::function<std::string(const Config&)> value;
+};
+
+std::string section_of(const std::string& k) { return k.substr(0, k.find('.')); }
+std::string leaf_of(const std::string& k) { return k.substr(k.find('.') + 1); }
+
+double as_number(const std::string& key, const toml::node& n, const std::string& allowed) {
+  if (auto v = n.value_exact<double>()) return *v;
+  if (auto v = n.value_exact<int64_t>()) return double(*v);
+  bad(key, show(n), allowed);
+}
+
+int64_t as_integer(const std::string& key, const toml::node& n, const std::string& allowed) {
+  if (auto v = n.value_exact<int64_t>()) return *v;
+  if (auto v = n.value_exact<double>())  // 2.0 is accepted as 2, 2.5 is not
+    if (std::isfinite(*v) && std::floor(*v) == *v && std::abs(*v) < 9e15) return int64_t(*v);
+  bad(key, show(n), allowed);
+}
+
+// A real number in (lo, hi] or [lo, hi] (lo_open picks), finite.
+Key real(std::string name, double Config::*m, double lo, bool lo_open, double hi,
+         std::string help) {
+  std::string allowed = "a number " + std::string(lo_open ? "> " : ">= ") + fmt(lo) +
+                        (hi < std::numeric_limits<double>::max() ? " and <= " + fmt(hi) : "");
+  Key k;
+  k.name = name;
+  k.help = help;
+  k.set = [=](Config& c, const toml::node& n) {
+    const double v = as_number(name, n, allowed + " (" + help + ")");
+    if (!std::isfinite(v) || (lo_open ? v <= lo : v < lo) || v > hi)
+      bad(name, show(n), allowed + " (" + help + ")");
+    c.*m = v;
+  };
+  k.put = [=](const Config& c, toml::table& t) { t.insert_or_assign(leaf_of(name), c.*m); };
+  k.value = [=](const Config& c) { return fmt(c.*m); };
+  return k;
+}
+
+template <class Int>
+Key integer(std::string name, Int Config::*m, int64_t lo, int64_t hi, std::string help) {
+  std::string allowed = "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  Key k;
+  k.name = name;
+  k.help = help;
+  k.set = [=](Config& c, const toml::node& n) {
+    const int64_t v = as_integer(name, n, allowed + " (" + help + ")");
+    if (v < lo || v > hi) bad(name, show(n), allowed + " (" + help + ")");
+    c.*m = Int(v);
+  };
+  k.put = [=](const Config& c, toml::table& t) { t.insert_or_assign(leaf_of(name), int64_t(c.*m)); };
+  k.value = [=](const Config& c) { return std::to_string(c.*m); };
+  return k;
+}
+
+Key boolean(std::string name, bool Config::*m, std::string help) {
+  Key k;
+  k.name = name;
+  k.help = help;
+  k.set = [=](Config& c, const toml::node& n) {
+    auto v = n.value_exact<bool>();
+    if (!v) bad(name, show(n), "true or false (" + help + ")");
+    c.*m = *v;
+  };
+  k.put = [=](const Config& c, toml::table& t) { t.insert_or_assign(leaf_of(name), c.*m); };
+  k.value = [=](const Config& c) { return std::string(c.*m ? "true" : "false"); };
+  return k;
+}
+
+Key real_array(std::string name, std::vector<double> Config::*m, double max_abs, std::string help) {
+  const std::string allowed = "an array of numbers with |value| <= " + fmt(max_abs) + " (" + help + ")";
+  Key k;
+  k.name = name;
+  k.help = help;
+  k.set = [=](Config& c, const toml::node& n) {
+    const toml::array* a = n.as_array();
+    if (!a) bad(name, show(n), allowed);
+    std::vector<double> out;
+    for (const toml::node& e : *a) {
+      const double v = as_number(name, e, allowed);
+      if (!std::isfinite(v) || std::abs(v) > max_abs) bad(name, show(n), allowed);
+      out.push_back(v);
+    }
+    c.*m = out;
+  };
+  k.put = [=](const Config& c, toml::table& t) {
+    toml::array a;
+    for (double v : c.*m) a.push_back(v);
+    t.insert_or_assign(leaf_of(name), a);
+  };
+  k.value = [=](const Config& c) {
+    std::string s = "[";
+    for (std::size_t i = 0; i < (c.*m).size(); ++i) s += (i ? ", " : "") + fmt((c.*m)[i]);
+    return s + "]";
+  };
+  return k;
+}
+
+const double inf = std::numeric_limits<double>::max();
+
+// The public interface: every key ibrod understands, in output order.
+const std::vector<Key>& schema() {
+  static const std::vector<Key> keys = {
+      integer("grid.n", &Config::grid_n, 8, 1024, "grid points per box edge, even"),
+      real("grid.box_A", &Config::grid_box_A, 0, true, inf, "periodic box edge L, Å"),
+      integer("grid.kernel_width", &Config::grid_kernel_width, 1, 16,
+              "kernel width c/h, a positive integer"),
+      real("time.dt_ns", &Config::time_dt_ns, 0, true, inf, "time step Δt, ns"),
+      real("time.t_end_us", &Config::time_t_end_us, 0, true, inf, "simulated time, µs"),
+      real("time.stop_kinetic_kT", &Config::time_stop_kinetic_kT, 0, false, inf,
+           "stop when the fluid kinetic energy falls below this, kT (0: never)"),
+      integer("rod.base_pairs", &Config::rod_base_pairs, 8, 1000000,
+              "rod points = base pairs n"),
+      integer("rod.excess_link", &Config::rod_excess_link, -1000, 1000,
+              "excess link ΔLk of the initial circle, an integer"),
+      real_array("rod.perturbation", &Config::rod_perturbation, 100.0,
+                 "twist perturbation amplitudes ε_m for m = 1, 2, …, rad"),
+      real("rod.rise_A", &Config::rod_rise_A, 0, true, inf, "rise per base pair Δs, Å"),
+      real("rod.bend_modulus_erg_cm", &Config::rod_bend_modulus_erg_cm, 0, true, inf,
+           "bending moduli a1 = a2, erg·cm"),
+      real("rod.twist_modulus_erg_cm", &Config::rod_twist_modulus_erg_cm, 0, true, inf,
+           "twist modulus a3, erg·cm"),
+      real("rod.shear_modulus_dyn", &Config::rod_shear_modulus_dyn, 0, true, inf,
+           "shear constants b1 = b2, dyn"),
+      real("rod.stretch_modulus_dyn", &Config::rod_stretch_modulus_dyn, 0, true, inf,
+           "stretch constant b3, dyn"),
+      real("rod.intrinsic_twist_per_A", &Config::rod_intrinsic_twist_per_A, -inf, false, inf,
+           "intrinsic twist Ω³₀, rad/Å (0: untwisted reference)"),
+      real("solvent.salt_M", &Config::solvent_salt_M, 0, false, 10.0,
+           "monovalent salt concentration Cs, mol/L"),
+      real("solvent.viscosity_poise", &Config::solvent_viscosity_poise, 0, true, inf,
+           "viscosity μ, poise (g/(cm·s))"),
+      real("solvent.density_g_cm3", &Config::solvent_density_g_cm3, 0, true, inf,
+           "density ρ, g/cm³"),
+      real("solvent.temperature_K", &Config::solvent_temperature_K, 0, true, inf,
+           "temperature for kT, K"),
+      boolean("solvent.advection", &Config::solvent_advection,
+              "include the nonlinear advection term ρ u·∇u"),
+      boolean("electrostatics.enabled", &Config::electrostatics_enabled,
+              "Debye–Hückel repulsion between rod points"),
+      real("electrostatics.charge_e", &Config::electrostatics_charge_e, 0, false, inf,
+           "net charge per base pair, e"),
+      real("electrostatics.dielectric", &Config::electrostatics_dielectric, 0, true, inf,
+           "dielectric constant of water εw"),
+      real("electrostatics.cutoff_debye", &Config::electrostatics_cutoff_debye, 0, true, inf,
+           "pair cutoff in Debye lengths 1/κ"),
+      boolean("steric.enabled", &Config::steric_enabled, "hard-core repulsion between segments"),
+      real("steric.diameter_A", &Config::steric_diameter_A, 0, true, inf,
+           "hard-core diameter D, Å"),
+      real("steric.stiffness", &Config::steric_stiffness_kT_A2, 0, false, inf,
+           "hard-core spring constant g, kT/Å²"),
+      integer("output.every_steps", &Config::output_every_steps, 1,
+              std::numeric_limits<int64_t>::max(), "steps between diagnostics rows"),
+      integer("run.threads", &Config::run_threads, 0, 1024,
+              "threads (0: OMP_NUM_THREADS or all cores)"),
+      boolean("run.fftw_measure", &Config::run_fftw_measure,
+              "time FFTW plans at start (faster steps) instead of estimating them"),
+  };
+  return keys;
+}
+
+const Key* find_key(const std::string& name) {
+  for (const Key& k : schema())
+    if (k.name == name) return &k;
+  return nullptr;
+}
+
+std::string known_keys_in(const std::string& section) {
+  std::string s;
+  for (const Key& k : schema())
+    if (section_of(k.name) == section) s += (s.empty() ? "" : ", ") + leaf_of(k.name);
+  return s;
+}
+
+std::string known_sections() {
+  std::string s;
+  std::string last;
+  for (const Key& k : schema()) {
+    const std::string sec = section_of(k.name);
+    if (sec != last) s += (s.empty() ? "" : ", ") + sec;
+    last = sec;
+  }
+  return s;
+}
+
+void set_key(Config& c, const std::string& name, const toml::node& n) {
+  const Key* k = find_key(name);
+  if (!k) {
+    const std::string known = known_keys_in(section_of(name));
+    if (name.find('.') == std::string::npos || known.empty())
+      throw ConfigError("config: unknown key '" + name + "' (sections are: " + known_sections() +
+                        ")");
+    throw ConfigError("config: unknown key '" + name + "' (keys in [" + section_of(name) +
+                      "]: " + known + ")");
+  }
+  k->set(c, n);
+}
+
+}  // namespace
+
+void apply_toml(Config& c, const std::string& text, const std::string& source) {
+  toml::table tbl;
+  try {
+    tbl = toml::parse(text, source);
+  } catch (const toml::parse_error& e) {
+    std::ostringstream os;
+    os << "config: " << source << ":" << e.source().begin.line << ":" << e.source().begin.column
+       << ": TOML syntax error: " << e.description();
+    throw ConfigError(os.str());
+  }
+  for (auto&& [sec, node] : tbl) {
+    const std::string s(sec.str());
+    const toml::table* t = node.as_table();
+    if (!t)
+      throw ConfigError("config: top-level key '" + s + "' must be a section [" + s +
+                        "] (sections are: " + known_sections() + ")");
+    for (auto&& [key, value] : *t) set_key(c, s + "." + std::string(key.str()), value);
+  }
+}
+
+Config load_config(const std::string& path) {
+  Config c;
+  if (path.empty()) return c;
+  std::ifstream in(path);
+  if (!in) throw ConfigError("config: cannot read file '" + path + "'");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  apply_toml(c, ss.str(), path);
+  return c;
+}
+
+void apply_override(Config& c, const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw ConfigError("config: --set '" + assignment + "' must have the form section.key=value");
+  std::string key = assignment.substr(0, eq), value = assignment.substr(eq + 1);
+  while (!key.empty() && key.back() == ' ') key.pop_back();
+  toml::table t;
+  try {
+    t = toml::parse("v = " + value, "--set " + key);
+  } catch (const toml::parse_error& e) {
+    throw ConfigError("config: --set " + key + "=" + value +
+                      ": the value is not a TOML number, boolean, string or array (" +
+                      std::string(e.description()) + ")");
+  }
+  set_key(c, key, *t.get("v"));
+}
+
+void validate(const Config& c) {
+  if (c.grid_n % 2 != 0)
+    bad("grid.n", std::to_string(c.grid_n), "an even integer >= 8 (real-to-complex FFT grid)");
+  if (4 * c.grid_kernel_width + 2 > c.grid_n)
+    bad("grid.kernel_width", std::to_string(c.grid_kernel_width),
+        "an integer m with 4m + 2 <= grid.n = " + std::to_string(c.grid_n) +
+            " (the kernel must fit in the grid)");
+  const double r0 = c.rod_base_pairs * c.rod_rise_A / (2 * std::numbers::pi);
+  const double extent = 2 * r0 + c.steric_diameter_A;
+  if (extent >= c.grid_box_A)
+    bad("grid.box_A", fmt(c.grid_box_A),
+        "a box larger than the ring: rod.base_pairs = " + std::to_string(c.rod_base_pairs) +
+            " at rod.rise_A = " + fmt(c.rod_rise_A) + " gives a ring of diameter " +
+            fmt(2 * r0) + " Å (plus the hard core " + fmt(c.steric_diameter_A) + " Å)");
+  if (c.time_dt_ns * 1e-3 > c.time_t_end_us)
+    bad("time.t_end_us", fmt(c.time_t_end_us),
+        "at least one time step (time.dt_ns = " + fmt(c.time_dt_ns) + " ns)");
+  // MODEL §5: sin β must be a sine
+  const double a = c.rod_bend_modulus_erg_cm * units::erg_cm;
+  const double a3 = c.rod_twist_modulus_erg_cm * units::erg_cm;
+  const double b = c.rod_shear_modulus_dyn * units::dyn;
+  const double rr = c.rod_rise_A * c.rod_base_pairs / (2 * std::numbers::pi);
+  const double sb = -a3 * c.rod_excess_link / (b * rr * rr + a3 - a);
+  if (!(std::abs(sb) < 1))
+    bad("rod.excess_link", std::to_string(c.rod_excess_link),
+        "a link small enough that the twisted circle exists (|sin β| = " + fmt(std::abs(sb)) +
+            " >= 1)");
+}
+
+std::string to_toml(const Config& c) {
+  toml::table root;
+  for (const Key& k : schema()) {
+    const std::string sec = section_of(k.name);
+    if (!root.contains(sec)) root.insert(sec, toml::table{});
+    k.put(c, *root[sec].as_table());
+  }
+  std::ostringstream os;
+  os << "# ibrod resolved configuration (every key, defaults included)\n" << root << "\n";
+  return os.str();
+}
+
+std::string describe(const Config& c) {
+  std::ostringstream os;
+  for (const Key& k : schema()) {
+    std::string lhs = k.name + " = " + k.value(c);
+    if (lhs.size() < 44) lhs.resize(44, ' ');
+    os << lhs << " # " << k.help << "\n";
+  }
+  return os.str();
+}
+
+sim::SimParams to_params(const Config& c) {
+  using namespace units;
+  sim::SimParams p;
+  auto& s = p.stepper;
+  s.grid.n = c.grid_n;
+  s.grid.L = c.grid_box_A * angstrom;
+  s.kernel_width = c.grid_kernel_width;
+  s.fluid.density = c.solvent_density_g_cm3 * g_per_cm3;
+  s.fluid.viscosity = c.solvent_viscosity_poise * poise;
+  s.fluid.dt = c.time_dt_ns * ns;
+  s.fluid.advection = c.solvent_advection;
+  s.rod.n = c.rod_base_pairs;
+  s.rod.ds = c.rod_rise_A * angstrom;
+  const double a = c.rod_bend_modulus_erg_cm * erg_cm;
+  s.rod.a = Vec3(a, a, c.rod_twist_modulus_erg_cm * erg_cm);
+  const double b = c.rod_shear_modulus_dyn * dyn;
+  s.rod.b = Vec3(b, b, c.rod_stretch_modulus_dyn * dyn);
+  s.rod.omega0 = Vec3(0, 0, c.rod_intrinsic_twist_per_A);
+  p.kT = kT(c.solvent_temperature_K);
+  // MODEL (2.19–2.22): A = q²/(4π ε0 εw), κ = 0.329 √Cs
+  s.electro.enabled = c.electrostatics_enabled;
+  s.electro.law.A = c.electrostatics_charge_e * c.electrostatics_charge_e /
+                    (4 * std::numbers::pi * vacuum_permittivity * c.electrostatics_dielectric);
+  s.electro.law.kappa = debye_kappa(c.solvent_salt_M);
+  s.electro.cutoff =
+      s.electro.law.kappa > 0 ? c.electrostatics_cutoff_debye / s.electro.law.kappa : 0.0;
+  s.steric.enabled = c.steric_enabled;
+  s.steric.diameter = c.steric_diameter_A;
+  s.steric.stiffness = c.steric_stiffness_kT_A2 * p.kT;
+  s.steric.ds = s.rod.ds;
+  s.threads = c.run_threads;
+  s.plan_measure = c.run_fftw_measure;
+  p.circle.excess_link = c.rod_excess_link;
+  p.circle.perturbation = c.rod_perturbation;
+  // the ring sits in the middle of the box
+  p.circle.center = Vec3::Constant(0.5 * s.grid.L);
+  p.t_end = c.time_t_end_us * us;
+  p.stop_kinetic = c.time_stop_kinetic_kT * p.kT;
+  p.output_every = c.output_every_steps;
+  return p;
+}
+
+std::string derived_report(const Config& c) {
+  const auto p = to_params(c);
+  const auto& s = p.stepper;
+  const double h = s.grid.h();
+  const double r0 = s.rod.n * s.rod.ds / (2 * std::numbers::pi);
+  const double sb = -s.rod.a[2] * c.rod_excess_link / (s.rod.b[0] * r0 * r0 + s.rod.a[2] - s.rod.a[0]);
+  const auto steps = int64_t(std::ceil(p.t_end / s.fluid.dt - 0.5));
+  const double N3 = double(s.grid.size());
+  // velocity + force (3 real arrays each) + spectrum (3 complex half arrays)
+  const double fluid_bytes = 8.0 * (6 * N3 + 2 * 3 * s.grid.n * s.grid.n * (s.grid.n / 2 + 1));
+  std::ostringstream os;
+  os.precision(5);
+  os << "grid spacing h            = " << h << " Å\n"
+     << "kernel width c            = " << c.grid_kernel_width * h << " Å (" << c.grid_kernel_width
+     << " h)\n"
+     << "rod spacing Δs            = " << s.rod.ds << " Å\n"
+     << "ring radius r0            = " << r0 << " Å\n"
+     << "tilt angle β              = " << std::asin(sb) << " rad\n"
+     << "kT                        = " << p.kT << " g Å² s⁻²\n"
+     << "Debye length 1/κ          = "
+     << (s.electro.law.kappa > 0 ? 1.0 / s.electro.law.kappa : INFINITY) << " Å\n"
+     << "Bjerrum length            = "
+     << units::bjerrum_length(c.electrostatics_dielectric, c.solvent_temperature_K) << " Å\n"
+     << "electrostatic cutoff      = " << s.electro.cutoff << " Å\n"
+     << "steric stiffness g        = " << s.steric.stiffness << " g s⁻²\n"
+     << "time steps                = " << steps << "\n"
+     << "diagnostics rows          = " << steps / p.output_every + 1 << "\n"
+     << "memory estimate           = " << (fluid_bytes + 400.0 * s.rod.n) / (1 << 20) << " MiB\n";
+  return os.str();
+}
+
+}  // namespace ibrod::io
