@@ -11,6 +11,8 @@ packages=(
   libcli11-dev          # command line
   libgtest-dev libgmock-dev libbenchmark-dev   # tests and micro-benchmarks
   libhdf5-dev           # H5MD trajectories
+  nlohmann-json3-dev    # summary.json (reads and writes, with null)
+  libpng-dev            # rendered pictures of the rod
   python3 python3-numpy python3-matplotlib python3-h5py   # analysis and plots
 )
 
