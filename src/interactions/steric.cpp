@@ -1,0 +1,174 @@
+// Hard-core repulsion between non-neighbouring rod segments, MODEL (2.17–2.18); Lim, Kim &
+// Swigon 2011. The paper's contact of mutual closest material points is taken segment by segment.
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+
+#include "interactions/cell_list.hpp"
+#include "interactions/interactions.hpp"
+
+namespace ibrod::interactions {
+
+namespace {
+inline double clamp01(double x) { return std::clamp(x, 0.0, 1.0); }
+}  // namespace
+
+SegmentContact closest_points(const Vec3& P0, const Vec3& P1, const Vec3& Q0, const Vec3& Q1) {
+  const Vec3 d1 = P1 - P0, d2 = Q1 - Q0, r = P0 - Q0;
+  const double a = d1.squaredNorm(), e = d2.squaredNorm();
+  const double b = d1.dot(d2), c = d1.dot(r), f = d2.dot(r);
+  double s = 0, t = 0;
+  if (a <= 0 && e <= 0) {  // two points
+  } else if (a <= 0) {     // P is a point: project it on Q
+    t = clamp01(f / e);
+  } else if (e <= 0) {  // Q is a point: project it on P
+    s = clamp01(-c / a);
+  } else {
+    const Vec3 nrm = d1.cross(d2);
+    const double denom = nrm.squaredNorm();  // = ae − b², without its cancellation
+    if (denom > 1e-20 * a * e) {
+      // closest points of the two lines, s = (bf − ce)/(ae − b²), clamped to P
+      s = clamp01(nrm.cross(d2).dot(r) / denom);
+    } else {
+      // parallel: the minimisers fill the overlap of P with Q's projection on P; take its middle
+      const double sa = -c / a, sb = (b - c) / a;  // Q0, Q1 projected on P's parameter
+      const double lo = std::max(0.0, std::min(sa, sb)), hi = std::min(1.0, std::max(sa, sb));
+      s = lo <= hi ? 0.5 * (lo + hi) : (std::max(sa, sb) < 0.0 ? 0.0 : 1.0);
+    }
+    // the point of Q nearest P(s); if it is off Q, clamp it and re-project onto P
+    t = (b * s + f) / e;
+    if (t < 0) {
+      t = 0;
+      s = clamp01(-c / a);
+    } else if (t > 1) {
+      t = 1;
+      s = clamp01((b - c) / a);
+    }
+  }
+  SegmentContact k;
+  k.s = s;
+  k.t = t;
+  k.sep = (P0 + s * d1) - (Q0 + t * d2);
+  k.d = k.sep.norm();
+  return k;
+}
+
+double steric_pair(double D, double g, const Vec3& P0, const Vec3& P1, const Vec3& Q0,
+                   const Vec3& Q1, std::array<Vec3, 4>& f) {
+  const SegmentContact k = closest_points(P0, P1, Q0, Q1);
+  if (!(k.d < D)) {
+    for (Vec3& v : f) v.setZero();
+    return 0;
+  }
+  Vec3 u;
+  if (k.d > 0) {
+    u = k.sep / k.d;
+  } else {  // the segments touch: push along their common normal (any normal if parallel)
+    Vec3 nrm = (P1 - P0).cross(Q1 - Q0);
+    if (nrm.squaredNorm() == 0) nrm = (P1 - P0).unitOrthogonal();
+    u = nrm.normalized();
+  }
+  const double overlap = D - k.d;
+  const Vec3 fu = (g * overlap) * u;  // MODEL (2.18): g (D − d) along P(s) − Q(t)
+  f[0] = (1 - k.s) * fu;
+  f[1] = k.s * fu;
+  f[2] = -(1 - k.t) * fu;
+  f[3] = -k.t * fu;
+  return 0.5 * g * overlap * overlap;  // MODEL (2.17)
+}
+
+namespace {
+
+/// Whether segments k and l (of n, closed rod) are more than 2D apart along the rod.
+inline bool far_along_rod(int k, int l, int n, double ds, double D) {
+  const int m = std::abs(k - l);
+  return std::min(m, n - m) * ds > 2 * D;
+}
+
+/// Segment pair k, l: adds the forces on X_k, X_{k+1}, X_l, X_{l+1} into F (indexed by point);
+/// returns the energy.
+inline double segment_pair(const StericParams& p, std::span<const Vec3> X, int k, int l, Vec3* F) {
+  const int n = int(X.size());
+  const int k1 = (k + 1) % n, l1 = (l + 1) % n;
+  std::array<Vec3, 4> f;
+  const double E = steric_pair(p.diameter, p.stiffness, X[k], X[k1], X[l], X[l1], f);
+  if (E > 0) {
+    F[k] += f[0];
+    F[k1] += f[1];
+    F[l] += f[2];
+    F[l1] += f[3];
+  }
+  return E;
+}
+
+}  // namespace
+
+Steric::Steric(const StericParams& p, int n) : p_(p) {
+  cells_.order.reserve(n);
+  cells_.cell.reserve(n);
+  cells_.x.reserve(n);
+  mid_.reserve(n);
+}
+
+double Steric::accumulate(std::span<const Vec3> X, std::span<Vec3> F) {
+  used_cells_ = false;
+  const int n = int(X.size());
+  if (!p_.enabled || n < 2 || !(p_.diameter > 0)) return 0;
+  // midpoints and the longest segment: closest distance < D ⇒ midpoints < D + L_max apart
+  mid_.resize(n);
+  double lmax2 = 0;
+  for (int k = 0; k < n; ++k) {
+    const Vec3& a = X[k];
+    const Vec3& b = X[(k + 1) % n];
+    mid_[k] = 0.5 * (a + b);
+    lmax2 = std::max(lmax2, (b - a).squaredNorm());
+  }
+  const double reach = p_.diameter + std::sqrt(lmax2);
+  const double reach2 = reach * reach;
+  const detail::CellGrid g = detail::make_grid(mid_, reach, 4 * n + 64);
+  used_cells_ = !g.trivial();
+  const StericParams p = p_;
+  if (!used_cells_) {
+    return detail::parallel_pairs(n, F, thread_F_, thread_E_, [&](int k, Vec3* Ft, double& E) {
+      for (int l = k + 1; l < n; ++l)
+        if ((mid_[k] - mid_[l]).squaredNorm() < reach2 && far_along_rod(k, l, n, p.ds, p.diameter))
+          E += segment_pair(p, X, k, l, Ft);
+    });
+  }
+  detail::bin(g, mid_, cells_);
+  const detail::CellScratch& c = cells_;
+  return detail::parallel_pairs(n, F, thread_F_, thread_E_, [&](int a, Vec3* Ft, double& E) {
+    const int k = c.order[a];
+    detail::for_each_partner(g, c, a, [&](int b) {
+      const int l = c.order[b];
+      if ((c.x[a] - c.x[b]).squaredNorm() < reach2 && far_along_rod(k, l, n, p.ds, p.diameter))
+        E += segment_pair(p, X, std::min(k, l), std::max(k, l), Ft);
+    });
+  });
+}
+
+double Steric::accumulate_direct(std::span<const Vec3> X, std::span<Vec3> F) const {
+  if (!p_.enabled) return 0;
+  const int n = int(X.size());
+  if (n < 2) return 0;
+  double E = 0;
+  for (int k = 0; k < n; ++k)
+    for (int l = k + 1; l < n; ++l)
+      if (far_along_rod(k, l, n, p_.ds, p_.diameter)) E += segment_pair(p_, X, k, l, F.data());
+  return E;
+}
+
+double Steric::energy(std::span<const Vec3> X) const {
+  if (!p_.enabled) return 0;
+  const int n = int(X.size());
+  if (n < 2) return 0;
+  double E = 0;
+  std::array<Vec3, 4> f;
+  for (int k = 0; k < n; ++k)
+    for (int l = k + 1; l < n; ++l)
+      if (far_along_rod(k, l, n, p_.ds, p_.diameter))
+        E += steric_pair(p_.diameter, p_.stiffness, X[k], X[(k + 1) % n], X[l], X[(l + 1) % n], f);
+  return E;
+}
+
+}  // namespace ibrod::interactions
