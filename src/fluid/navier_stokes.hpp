@@ -9,6 +9,7 @@
 #include <array>
 #include <complex>
 #include <cstddef>
+#include <vector>
 
 #include "core/grid.hpp"
 
@@ -33,6 +34,8 @@ class FluidSolver {
 
   const GridSpec& grid() const { return grid_; }
   const FluidParams& params() const { return params_; }
+  /// threads used by FFTW and the OpenMP loops (resolved: never 0)
+  int threads() const { return threads_; }
 
   /// velocity component c (0, 1, 2), Å s⁻¹, grid().size() values, layout GridSpec::index
   double* velocity(int c) { return u_[c]; }
@@ -54,6 +57,10 @@ class FluidSolver {
   /// max over the grid of |D_h·u| (central-difference divergence), s⁻¹.
   double max_divergence() const;
 
+  /// Benchmark aid: executes the forward and the backward plan once on the solver's own buffers
+  /// (the 6 real FFTs of one step), clobbering force and velocity. Not part of the physics.
+  void run_ffts_only();
+
  private:
   GridSpec grid_;
   FluidParams params_;
@@ -62,6 +69,11 @@ class FluidSolver {
   std::array<std::complex<double>*, 3> fh_{};  // r̂, then ûⁿ⁺¹
   void* plan_forward_ = nullptr;               // fftw_plan r → r̂ (3 components)
   void* plan_backward_ = nullptr;              // fftw_plan ûⁿ⁺¹ → u (3 components)
+  int threads_ = 1;
+  std::vector<int> next_, prev_;     // periodic neighbour index i ± 1 (mod n), made once
+  std::vector<double> grad_symbol_;  // sin(2πk/n)/h, Å⁻¹, k = 0..n−1; exactly 0 at k = 0, n/2
+  std::vector<double> lap_symbol_;   // (4/h²) sin²(πk/n), Å⁻², k = 0..n−1 (= −L̂ per direction)
+  void release();                    // frees plans and buffers (destructor, failed constructor)
 };
 
 }  // namespace ibrod::fluid
