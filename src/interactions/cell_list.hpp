@@ -39,18 +39,24 @@ struct CellGrid {
 /// (coarsening keeps the edge ≥ min_edge, hence correctness).
 inline CellGrid make_grid(std::span<const Vec3> pts, double min_edge, int max_cells) {
   Vec3 lo = Vec3::Constant(HUGE_VAL), hi = Vec3::Constant(-HUGE_VAL);
+  bool finite = true;  // checked per point: min/max would silently drop a NaN
   for (const Vec3& x : pts) {
+    finite = finite && x.allFinite();
     lo = lo.cwiseMin(x);
     hi = hi.cwiseMax(x);
   }
-  if (!lo.allFinite() || !hi.allFinite())
-    throw RunError("interactions: non-finite rod position in the cell list");
+  if (!finite || !lo.allFinite() || !hi.allFinite())
+    throw RunError("interactions: a rod position became non-finite (NaN/Inf): the simulation blew "
+                   "up, most likely because time.dt_ns is too large for the stretch/shear or steric "
+                   "stiffness");
   CellGrid g;
   g.lo = lo;
   const double edge = min_edge * (1.0 + 1e-9);
   for (int a = 0; a < 3; ++a) {
     const double ext = hi[a] - lo[a];
-    g.nc[a] = int(std::clamp(std::floor(ext / edge), 1.0, double(max_cells)));
+    // per-axis cap first, so that the product below cannot overflow (a blown-up rod has a huge
+    // extent); coarsening keeps every edge ≥ min_edge
+    g.nc[a] = int(std::clamp(std::floor(ext / edge), 1.0, double(std::min(max_cells, 1024))));
   }
   while (g.size() > max_cells) {  // coarsen the finest axis
     int a = int(std::max_element(g.nc.begin(), g.nc.end()) - g.nc.begin());
