@@ -1,17 +1,23 @@
 // ibrod command-line program.
-//   ibrod run   [CONFIG] [--set k=v]... [-o DIR] [--overwrite]
+//   ibrod run   [CONFIG] [--set k=v]... [-o DIR] [--overwrite] [--fftw-wisdom FILE]
+//   ibrod run   --resume DIR [--force] [--set k=v]...
 //   ibrod check [CONFIG] [--set k=v]...
 //   ibrod bench [CONFIG] [--set k=v]... [--steps K] [--threads T]
-// Exit status: 0 success, 2 invalid input (config, arguments, output directory), 3 the run failed
-// (non-finite state, I/O), 1 anything else.
+//   ibrod analyze DIR | render DIR [--time T] [--views ...] | sweep SWEEP.toml [-j K]
+// Exit status: 0 success, 2 invalid input (config, arguments, output directory, unusable
+// checkpoint), 3 the run failed (blow-up, I/O such as a full disk), 128 + N stopped by signal N
+// (SIGINT 130, SIGTERM 143) after writing a checkpoint, 1 anything else.
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 #include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
 
 #include "core/error.hpp"
+#include "cmd_analysis.hpp"
+#include "cmd_sweep.hpp"
 #include "io/bench.hpp"
 #include "io/config.hpp"
 #include "io/run.hpp"
@@ -35,11 +41,26 @@ int main(int argc, char** argv) {
   std::vector<std::string> sets;
   bool overwrite = false;
 
+  std::string resume_dir, wisdom;
+  bool force = false;
   auto* run = app.add_subcommand("run", "run one trajectory");
-  run->add_option("config", config_path, "TOML config (default: the built-in reference run)");
+  auto* run_config =
+      run->add_option("config", config_path, "TOML config (default: the built-in reference run)");
   run->add_option("--set", sets, "override one key: section.key=value (repeatable)");
-  run->add_option("-o,--output", out_dir, "output directory")->capture_default_str();
-  run->add_flag("--overwrite", overwrite, "replace the files of an existing output directory");
+  auto* run_out = run->add_option("-o,--output", out_dir, "output directory")->capture_default_str();
+  auto* run_overwrite =
+      run->add_flag("--overwrite", overwrite, "replace the files of an existing output directory");
+  auto* run_resume = run->add_option(
+      "--resume", resume_dir,
+      "continue the stopped run in DIR from DIR/checkpoint.bin (reads DIR/config.toml)");
+  run_resume->excludes(run_config)->excludes(run_out)->excludes(run_overwrite);
+  run->add_flag("--force", force,
+                "with --resume: continue even if the configuration (with --set) differs from "
+                "the checkpoint's")
+      ->needs(run_resume);
+  run->add_option("--fftw-wisdom", wisdom,
+                  "import FFTW plans from FILE (e.g. another run's fftw.wisdom): runs that share "
+                  "plans agree bit for bit");
 
   auto* check = app.add_subcommand("check", "print the resolved parameters and derived quantities");
   check->add_option("config", config_path, "TOML config (default: the built-in reference run)");
@@ -53,14 +74,30 @@ int main(int argc, char** argv) {
   bench->add_option("--threads", bench_threads, "threads (0: run.threads of the config)")
       ->check(CLI::NonNegativeNumber);
 
+  add_analysis_commands(app);  // analyze, render (app/cmd_analysis.cpp)
+  add_sweep_command(app);      // sweep (app/cmd_sweep.cpp)
+
   try {
     app.parse(argc, argv);
+  } catch (const CLI::RuntimeError& e) {
+    // analyze, render and sweep run inside parse() and end with their own status
+    return e.get_exit_code();
   } catch (const CLI::ParseError& e) {
     const int rc = app.exit(e);
     return rc == 0 ? 0 : 2;
   }
 
+  const bool resuming = *run && !resume_dir.empty();
+  if (resuming) {
+    config_path = (std::filesystem::path(resume_dir) / "config.toml").string();
+    out_dir = resume_dir;
+  }
+
   try {
+    if (resuming && !std::filesystem::exists(config_path))
+      throw ibrod::ConfigError("resume: '" + resume_dir +
+                               "' holds no config.toml: it is not the output directory of an "
+                               "ibrod run");
     const ibrod::io::Config c = resolve(config_path, sets);
     if (*check) {
       std::printf("# resolved configuration\n%s\n# derived quantities\n%s",
@@ -76,7 +113,17 @@ int main(int argc, char** argv) {
     ibrod::io::RunOptions opt;
     opt.output_dir = out_dir;
     opt.overwrite = overwrite;
-    ibrod::io::run(c, opt);
+    opt.resume = resuming;
+    opt.force = force;
+    opt.fftw_wisdom = wisdom;
+    const ibrod::io::RunResult r = ibrod::io::run(c, opt);
+    if (r.signal != 0) {
+      std::fprintf(stderr,
+                   "ibrod: stopped by signal %d at step %lld; checkpoint written. Continue with: "
+                   "ibrod run --resume %s\n",
+                   r.signal, static_cast<long long>(r.steps), out_dir.c_str());
+      return 128 + r.signal;
+    }
     return 0;
   } catch (const ibrod::ConfigError& e) {
     std::fprintf(stderr, "ibrod: error: %s\n", e.what());

@@ -12,6 +12,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev   # tests and micro-benchmarks
   libhdf5-dev           # H5MD trajectories
   nlohmann-json3-dev    # summary.json (reads and writes, with null)
+  libopenmpi-dev openmpi-bin   # optional: mpirun -np K ibrod sweep (points shared among ranks)
+  libfftw3-mpi-dev      # optional: distributed FFTs for large grids (docs/sweeps.md)
   libpng-dev            # rendered pictures of the rod
   python3 python3-numpy python3-matplotlib python3-h5py   # analysis and plots
 )

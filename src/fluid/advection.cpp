@@ -1,6 +1,7 @@
 #include "fluid/advection.hpp"
 
 #include <cstddef>
+#include <type_traits>
 
 namespace ibrod::fluid::detail {
 namespace {
@@ -19,9 +20,12 @@ namespace {
 // One z-row (n contiguous points) of r_c += a u_c − b S_h(u)_c, with b4 = b/(4h) (the 1/(4h) of
 // the flux form folded in). c: the centre rows of u; xp, xm, yp, ym: the rows of the x/y
 // neighbours; z neighbours are k ± 1 in the same row, wrapped only at the two row ends.
+// assign: r_c = a u_c − b S_h(u)_c instead of r_c += …; a run-time flag, because target_clones
+// does not combine with templates, but the two loops below are separate, so both vectorise.
 IBROD_ROW_CLONES void advect_row(int n, const double* const* c, const double* const* xp,
                                  const double* const* xm, const double* const* yp,
-                                 const double* const* ym, double* const* r, double a, double b4) {
+                                 const double* const* ym, double* const* r, double a, double b4,
+                                 bool assign) {
   const double *u0 = c[0], *u1 = c[1], *u2 = c[2];
   const double *x0p = xp[0], *x1p = xp[1], *x2p = xp[2];
   const double *x0m = xm[0], *x1m = xm[1], *x2m = xm[2];
@@ -29,7 +33,7 @@ IBROD_ROW_CLONES void advect_row(int n, const double* const* c, const double* co
   const double *y0m = ym[0], *y1m = ym[1], *y2m = ym[2];
   double *r0 = r[0], *r1 = r[1], *r2 = r[2];
   // MODEL §4: r_c += a u_c − b S_h(u)_c in the flux form of advection.hpp
-  auto point = [&](int k, int kp, int km) {
+  auto point = [&](int k, int kp, int km, auto assign_tag) {
     const double ux = u0[k], uy = u1[k], uz = u2[k];
     const double fxp = ux + x0p[k], fxm = ux + x0m[k];  // twice the face velocities
     const double fyp = uy + y1p[k], fym = uy + y1m[k];
@@ -40,21 +44,31 @@ IBROD_ROW_CLONES void advect_row(int n, const double* const* c, const double* co
         fxp * x1p[k] - fxm * x1m[k] + fyp * y1p[k] - fym * y1m[k] + fzp * u1[kp] - fzm * u1[km];
     const double s2 =
         fxp * x2p[k] - fxm * x2m[k] + fyp * y2p[k] - fym * y2m[k] + fzp * u2[kp] - fzm * u2[km];
-    r0[k] += a * ux - b4 * s0;
-    r1[k] += a * uy - b4 * s1;
-    r2[k] += a * uz - b4 * s2;
+    if constexpr (decltype(assign_tag)::value) {
+      r0[k] = a * ux - b4 * s0;
+      r1[k] = a * uy - b4 * s1;
+      r2[k] = a * uz - b4 * s2;
+    } else {
+      r0[k] += a * ux - b4 * s0;
+      r1[k] += a * uy - b4 * s1;
+      r2[k] += a * uz - b4 * s2;
+    }
   };
-  point(0, 1, n - 1);
+  auto row = [&](auto assign_tag) {
+    point(0, 1, n - 1, assign_tag);
 #pragma omp simd
-  for (int k = 1; k < n - 1; ++k) point(k, k + 1, k - 1);
-  point(n - 1, 0, n - 2);
+    for (int k = 1; k < n - 1; ++k) point(k, k + 1, k - 1, assign_tag);
+    point(n - 1, 0, n - 2, assign_tag);
+  };
+  if (assign)
+    row(std::true_type{});
+  else
+    row(std::false_type{});
 }
 
-}  // namespace
-
-void accumulate_rhs(const GridSpec& grid, const int* next, const int* prev,
-                    std::array<const double*, 3> u, std::array<double*, 3> r, double a, double b,
-                    int threads) {
+void rhs_pass(const GridSpec& grid, const int* next, const int* prev,
+              std::array<const double*, 3> u, std::array<double*, 3> r, double a, double b,
+              int threads, bool assign) {
   const int n = grid.n;
   const std::size_t nz = std::size_t(n);
   // S_h carries 1/(4h): ½ from the skew average, ½h from each central difference.
@@ -68,11 +82,20 @@ void accumulate_rhs(const GridSpec& grid, const int* next, const int* prev,
       if (!advect) {  // Stokes: memory-bound, plain SSE2 is as fast as it gets
         const double *u0 = u[0] + oc, *u1 = u[1] + oc, *u2 = u[2] + oc;
         double *r0 = r[0] + oc, *r1 = r[1] + oc, *r2 = r[2] + oc;
+        if (assign) {
 #pragma omp simd
-        for (int k = 0; k < n; ++k) {
-          r0[k] += a * u0[k];
-          r1[k] += a * u1[k];
-          r2[k] += a * u2[k];
+          for (int k = 0; k < n; ++k) {
+            r0[k] = a * u0[k];
+            r1[k] = a * u1[k];
+            r2[k] = a * u2[k];
+          }
+        } else {
+#pragma omp simd
+          for (int k = 0; k < n; ++k) {
+            r0[k] += a * u0[k];
+            r1[k] += a * u1[k];
+            r2[k] += a * u2[k];
+          }
         }
         continue;
       }
@@ -86,9 +109,23 @@ void accumulate_rhs(const GridSpec& grid, const int* next, const int* prev,
       const double* yp[3] = {u[0] + oyp, u[1] + oyp, u[2] + oyp};
       const double* ym[3] = {u[0] + oym, u[1] + oym, u[2] + oym};
       double* rr[3] = {r[0] + oc, r[1] + oc, r[2] + oc};
-      advect_row(n, c, xp, xm, yp, ym, rr, a, b4);
+      advect_row(n, c, xp, xm, yp, ym, rr, a, b4, assign);
     }
   }
+}
+
+}  // namespace
+
+void accumulate_rhs(const GridSpec& grid, const int* next, const int* prev,
+                    std::array<const double*, 3> u, std::array<double*, 3> r, double a, double b,
+                    int threads) {
+  rhs_pass(grid, next, prev, u, r, a, b, threads, false);
+}
+
+void assign_rhs(const GridSpec& grid, const int* next, const int* prev,
+                std::array<const double*, 3> u, std::array<double*, 3> r, double a, double b,
+                int threads) {
+  rhs_pass(grid, next, prev, u, r, a, b, threads, true);
 }
 
 }  // namespace ibrod::fluid::detail

@@ -2,10 +2,13 @@
 
 #include <fftw3.h>
 #include <omp.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
 #include <mutex>
 #include <new>
 #include <numbers>
@@ -13,6 +16,7 @@
 #include <string>
 
 #include "fluid/advection.hpp"
+#include "fluid/fftw_wisdom.hpp"
 
 namespace ibrod::fluid {
 namespace {
@@ -27,7 +31,27 @@ void init_fftw_threads() {
 
 fftw_plan as_plan(void* p) { return static_cast<fftw_plan>(p); }
 
+// Best effort throughout: a cache that cannot be read or written only costs planning time.
+void save_wisdom_cache(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(fs::path(path).parent_path(), ec);
+  // write then rename: concurrent processes never see a half-written file
+  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
+  if (export_wisdom(tmp)) fs::rename(tmp, path, ec);
+  if (ec || fs::exists(tmp, ec)) fs::remove(tmp, ec);
+}
+
 }  // namespace
+
+std::string wisdom_cache_path() {
+  if (const char* p = std::getenv("IBROD_FFTW_WISDOM_CACHE")) return p;  // "" disables
+  if (const char* x = std::getenv("XDG_CACHE_HOME"); x && *x)
+    return std::string(x) + "/ibrod/fftw-wisdom";
+  if (const char* h = std::getenv("HOME"); h && *h)
+    return std::string(h) + "/.cache/ibrod/fftw-wisdom";
+  return {};
+}
 
 FluidSolver::FluidSolver(const GridSpec& grid, const FluidParams& params, int threads,
                          bool plan_measure)
@@ -87,10 +111,25 @@ FluidSolver::FluidSolver(const GridSpec& grid, const FluidParams& params, int th
   // FFTW_DESTROY_INPUT: step() owns both inputs as scratch (force is consumed, r̂ is rebuilt).
   const unsigned flags = (plan_measure ? FFTW_MEASURE : FFTW_ESTIMATE) | FFTW_DESTROY_INPUT;
   fftw_plan_with_nthreads(threads_);
-  plan_forward_ =
-      fftw_plan_many_dft_r2c(3, dims, 3, f, nullptr, 1, int(nr), fh, nullptr, 1, int(nc), flags);
-  plan_backward_ =
-      fftw_plan_many_dft_c2r(3, dims, 3, fh, nullptr, 1, int(nc), u, nullptr, 1, int(nr), flags);
+  auto make_plans = [&](unsigned fl) {
+    plan_forward_ =
+        fftw_plan_many_dft_r2c(3, dims, 3, f, nullptr, 1, int(nr), fh, nullptr, 1, int(nc), fl);
+    plan_backward_ =
+        fftw_plan_many_dft_c2r(3, dims, 3, fh, nullptr, 1, int(nc), u, nullptr, 1, int(nr), fl);
+    if (plan_forward_ && plan_backward_) return true;
+    release_plans();
+    return false;
+  };
+  if (!plan_measure) {
+    make_plans(flags);
+  } else if (!make_plans(flags | FFTW_WISDOM_ONLY)) {
+    // Wisdom already in the process (a resumed run imports its own first) wins; otherwise the
+    // on-disk cache, and only if that lacks these plans too, FFTW_MEASURE, saved for next time.
+    const std::string cache = wisdom_cache_path();
+    if (!cache.empty()) import_wisdom(cache);
+    if (!make_plans(flags | FFTW_WISDOM_ONLY) && make_plans(flags) && !cache.empty())
+      save_wisdom_cache(cache);
+  }
   if (!plan_forward_ || !plan_backward_) {
     release();
     throw std::runtime_error("FluidSolver: FFTW planning failed");
@@ -102,10 +141,14 @@ FluidSolver::FluidSolver(const GridSpec& grid, const FluidParams& params, int th
 
 FluidSolver::~FluidSolver() { release(); }
 
-void FluidSolver::release() {
+void FluidSolver::release_plans() {
   if (plan_forward_) fftw_destroy_plan(as_plan(plan_forward_));
   if (plan_backward_) fftw_destroy_plan(as_plan(plan_backward_));
   plan_forward_ = plan_backward_ = nullptr;
+}
+
+void FluidSolver::release() {
+  release_plans();
   fftw_free(u_[0]);  // fftw_free(nullptr) is a no-op
   fftw_free(f_[0]);
   fftw_free(fh_[0]);
@@ -122,19 +165,35 @@ void FluidSolver::zero_force() {
 }
 
 void FluidSolver::step() {
-  const int n = grid_.n;
-  const double rho = params_.density;
-  const double inertia = rho / params_.dt;  // ρ/Δt, g Å⁻³ s⁻¹
-  const double mu = params_.viscosity;
-
   // 1. r = ρuⁿ/Δt − ρS_h(uⁿ) + fⁿ, in place over the force (MODEL §4)
-  detail::accumulate_rhs(grid_, next_.data(), prev_.data(), {u_[0], u_[1], u_[2]}, f_, inertia,
-                         params_.advection ? rho : 0.0, threads_);
+  detail::accumulate_rhs(grid_, next_.data(), prev_.data(), {u_[0], u_[1], u_[2]}, f_,
+                         params_.density / params_.dt, params_.advection ? params_.density : 0.0,
+                         threads_);
+  finish_step();
+}
 
+void FluidSolver::begin_step() {
+  // r = ρuⁿ/Δt − ρS_h(uⁿ) over the force array; the caller adds fⁿ (MODEL §4)
+  detail::assign_rhs(grid_, next_.data(), prev_.data(), {u_[0], u_[1], u_[2]}, f_,
+                     params_.density / params_.dt, params_.advection ? params_.density : 0.0,
+                     threads_);
+}
+
+void FluidSolver::finish_step() {
   // 2. r̂ for all three components in one plan
   fftw_execute(as_plan(plan_forward_));
+  // 3. projection, implicit viscosity and the 1/n³ of the FFT round trip, one pass
+  spectral_pass();
+  // 4. uⁿ⁺¹ back in real space
+  fftw_execute(as_plan(plan_backward_));
+}
 
-  // 3. ûⁿ⁺¹ = P(k) r̂ / (ρ/Δt − μL̂(k)) / n³: the unnormalised FFTW round trip multiplies by n³.
+void FluidSolver::spectral_pass() {
+  const int n = grid_.n;
+  const double inertia = params_.density / params_.dt;  // ρ/Δt, g Å⁻³ s⁻¹
+  const double mu = params_.viscosity;
+
+  // ûⁿ⁺¹ = P(k) r̂ / (ρ/Δt − μL̂(k)) / n³: the unnormalised FFTW round trip multiplies by n³.
   const int nzh = n / 2 + 1;
   const double norm = 1.0 / double(grid_.size());
   const double* gs = grad_symbol_.data();
@@ -174,10 +233,12 @@ void FluidSolver::step() {
       }
     }
   }
-
-  // 4. uⁿ⁺¹ back in real space
-  fftw_execute(as_plan(plan_backward_));
 }
+
+void FluidSolver::run_spectral_only() { spectral_pass(); }
+
+void FluidSolver::run_forward_fft_only() { fftw_execute(as_plan(plan_forward_)); }
+void FluidSolver::run_backward_fft_only() { fftw_execute(as_plan(plan_backward_)); }
 
 void FluidSolver::run_ffts_only() {
   fftw_execute(as_plan(plan_forward_));

@@ -9,6 +9,7 @@
 #include <array>
 #include <complex>
 #include <cstddef>
+#include <string>
 #include <vector>
 
 #include "core/grid.hpp"
@@ -25,7 +26,10 @@ struct FluidParams {
 class FluidSolver {
  public:
   /// threads: FFTW/OpenMP threads (0 = OpenMP default). plan_measure: FFTW_MEASURE (true) or
-  /// FFTW_ESTIMATE (false; fast to plan, for tests).
+  /// FFTW_ESTIMATE (false; fast to plan, for tests). With FFTW_MEASURE, plans already in the
+  /// process's wisdom (e.g. a resumed run's own, imported first) are used as they are; otherwise
+  /// the wisdom cache (wisdom_cache_path()) is imported, and if it lacks these plans they are
+  /// measured and the cache rewritten. An unreadable or unwritable cache is ignored.
   FluidSolver(const GridSpec& grid, const FluidParams& params, int threads = 0,
               bool plan_measure = true);
   ~FluidSolver();
@@ -52,6 +56,15 @@ class FluidSolver {
   /// Advance u by one step Δt with the current force density (MODEL §4). No allocation.
   void step();
 
+  /// The same step in two halves, for a caller that spreads its forces in between:
+  ///   begin_step();  (accumulate (+=) the force density into force());  finish_step();
+  /// begin_step() overwrites force() with ρuⁿ/Δt − ρS_h(uⁿ) (no zero_force() needed, and the
+  /// force array is read once less than by step()); finish_step() does the FFTs and the solve and
+  /// leaves uⁿ⁺¹ in velocity(). Equal to zero_force(); spread; step() up to round-off (fⁿ is
+  /// added to the other terms of r in another order). No allocation.
+  void begin_step();
+  void finish_step();
+
   /// Fluid kinetic energy ½ρ Σ|u|² h³, g Å² s⁻².
   double kinetic_energy() const;
   /// max over the grid of |D_h·u| (central-difference divergence), s⁻¹.
@@ -60,6 +73,11 @@ class FluidSolver {
   /// Benchmark aid: executes the forward and the backward plan once on the solver's own buffers
   /// (the 6 real FFTs of one step), clobbering force and velocity. Not part of the physics.
   void run_ffts_only();
+  void run_forward_fft_only();   ///< the forward plan alone (benchmark aid, clobbers force)
+  void run_backward_fft_only();  ///< the backward plan alone (benchmark aid, clobbers velocity)
+  /// Benchmark aid: the spectral pass of finish_step() alone, on whatever the spectral buffer
+  /// holds. Not part of the physics.
+  void run_spectral_only();
 
  private:
   GridSpec grid_;
@@ -74,6 +92,13 @@ class FluidSolver {
   std::vector<double> grad_symbol_;  // sin(2πk/n)/h, Å⁻¹, k = 0..n−1; exactly 0 at k = 0, n/2
   std::vector<double> lap_symbol_;   // (4/h²) sin²(πk/n), Å⁻², k = 0..n−1 (= −L̂ per direction)
   void release();                    // frees plans and buffers (destructor, failed constructor)
+  void release_plans();
+  void spectral_pass();              // r̂ → ûⁿ⁺¹ in place: projection, viscosity, 1/n³
 };
+
+/// On-disk FFTW wisdom cache used by FluidSolver when plan_measure is set: $IBROD_FFTW_WISDOM_CACHE
+/// if set (empty: no cache), else $XDG_CACHE_HOME/ibrod/fftw-wisdom, else
+/// $HOME/.cache/ibrod/fftw-wisdom ("" if none of them is set).
+std::string wisdom_cache_path();
 
 }  // namespace ibrod::fluid

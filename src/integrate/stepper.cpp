@@ -41,9 +41,11 @@ StepEnergies Stepper::compute_forces(const rod::RodState& s) {
 
 void Stepper::step(rod::RodState& s) {
   last_ = compute_forces(s);
-  fluid_->zero_force();
+  // r = ρuⁿ/Δt − ρS_h(uⁿ) overwrites the force array, fⁿ is spread onto it, then the solve:
+  // MODEL §4's r without a zeroing pass (FluidSolver::begin_step)
+  fluid_->begin_step();
   coupler_.spread(s.X, F_, T_, fluid_->force());
-  fluid_->step();
+  fluid_->finish_step();
   const fluid::FluidSolver& fl = *fluid_;
   coupler_.interpolate(s.X, fl.velocity(), U_, W_);
   rod::advance(s, U_, W_, p_.fluid.dt);

@@ -143,6 +143,81 @@ Key real_array(std::string name, std::vector<double> Config::*m, double max_abs,
 
 const double inf = std::numeric_limits<double>::max();
 
+// output.frame_every_steps: −1 (the default) follows output.every_steps; written back resolved, so
+// that config.toml holds the number of steps actually used.
+Key frame_key() {
+  Key k = integer("output.frame_every_steps", &Config::output_frame_every_steps, -1,
+                  std::numeric_limits<int64_t>::max(),
+                  "steps between trajectory frames (H5MD and ParaView; 0: none, -1: same as "
+                  "output.every_steps)");
+  k.put = [](const Config& c, toml::table& t) {
+    t.insert_or_assign("frame_every_steps", int64_t(frame_every(c)));
+  };
+  k.value = [](const Config& c) { return std::to_string(frame_every(c)); };
+  return k;
+}
+
+// rod.perturbation_random = { modes = M, amplitude = A, seed = S }: an inline table (a Key whose
+// value is a table). A partial table changes only the sub-keys it names, so that `--set
+// rod.perturbation_random.seed=7` (see set_key) works on top of a file's table. Written back as the
+// table; the drawn ε_m follow from it exactly (io/perturbation.hpp) and `ibrod check` shows them.
+Key random_perturbation_key() {
+  const std::string name = "rod.perturbation_random";
+  const std::string help =
+      "random twist perturbation { modes = M, amplitude = A rad, seed = S }: ε_m, m = 1..M, "
+      "uniform in [-A, A) from std::mt19937_64(S), added to rod.perturbation";
+  Key k;
+  k.name = name;
+  k.help = help;
+  k.set = [=](Config& c, const toml::node& n) {
+    const toml::table* t = n.as_table();
+    if (!t) bad(name, show(n), "an inline table { modes = M, amplitude = A, seed = S }");
+    RandomPerturbation r = c.rod_perturbation_random;
+    for (auto&& [sub, v] : *t) {
+      const std::string s(sub.str());
+      const std::string full = name + "." + s;
+      if (s == "modes") {
+        const int64_t m = as_integer(full, v, "an integer in [0, 10000] (number of modes M)");
+        if (m < 0 || m > 10000) bad(full, show(v), "an integer in [0, 10000] (number of modes M)");
+        r.modes = int(m);
+      } else if (s == "amplitude") {
+        const double a = as_number(full, v, "a number in [0, 100] (amplitude A, rad)");
+        if (!std::isfinite(a) || a < 0 || a > 100)
+          bad(full, show(v), "a number in [0, 100] (amplitude A, rad)");
+        r.amplitude = a;
+      } else if (s == "seed") {
+        const int64_t sd = as_integer(full, v, "an integer >= 0 (seed of std::mt19937_64)");
+        if (sd < 0) bad(full, show(v), "an integer >= 0 (seed of std::mt19937_64)");
+        r.seed = std::uint64_t(sd);
+      } else {
+        throw ConfigError("config: unknown key '" + full + "' (keys in " + name +
+                          ": modes, amplitude, seed)");
+      }
+    }
+    c.rod_perturbation_random = r;
+  };
+  k.put = [](const Config& c, toml::table& t) {
+    const RandomPerturbation& r = c.rod_perturbation_random;
+    toml::table v{{"modes", int64_t(r.modes)}, {"amplitude", r.amplitude},
+                  {"seed", int64_t(r.seed)}};
+    v.is_inline(true);
+    t.insert_or_assign("perturbation_random", v);
+  };
+  k.value = [](const Config& c) {
+    const RandomPerturbation& r = c.rod_perturbation_random;
+    std::string s = "{ modes = " + std::to_string(r.modes) + ", amplitude = " + fmt(r.amplitude) +
+                    ", seed = " + std::to_string(r.seed) + " }";
+    const std::vector<double> eps = draw_perturbation(r);
+    if (!eps.empty()) {
+      s += " -> eps = [";
+      for (std::size_t i = 0; i < eps.size(); ++i) s += (i ? ", " : "") + fmt(eps[i]);
+      s += "]";
+    }
+    return s;
+  };
+  return k;
+}
+
 // The public interface: every key ibrod understands, in output order.
 const std::vector<Key>& schema() {
   static const std::vector<Key> keys = {
@@ -160,6 +235,7 @@ const std::vector<Key>& schema() {
               "excess link ΔLk of the initial circle, an integer"),
       real_array("rod.perturbation", &Config::rod_perturbation, 100.0,
                  "twist perturbation amplitudes ε_m for m = 1, 2, …, rad"),
+      random_perturbation_key(),
       real("rod.rise_A", &Config::rod_rise_A, 0, true, inf, "rise per base pair Δs, Å"),
       real("rod.bend_modulus_erg_cm", &Config::rod_bend_modulus_erg_cm, 0, true, inf,
            "bending moduli a1 = a2, erg·cm"),
@@ -196,6 +272,14 @@ const std::vector<Key>& schema() {
            "hard-core spring constant g, kT/Å²"),
       integer("output.every_steps", &Config::output_every_steps, 1,
               std::numeric_limits<int64_t>::max(), "steps between diagnostics rows"),
+      frame_key(),
+      integer("output.checkpoint_every_steps", &Config::output_checkpoint_every_steps, 0,
+              std::numeric_limits<int64_t>::max(),
+              "steps between checkpoints (0: only at the start, the end and on SIGINT/SIGTERM)"),
+      boolean("output.fluid_vti", &Config::output_fluid_vti,
+              "also write the fluid velocity (Å/ns) as a ParaView .vti image with every frame"),
+      boolean("output.fluid_velocity", &Config::output_fluid_velocity,
+              "write the final fluid velocity (Å/ns) as DIR/velocity.npy, shape (3, n, n, n)"),
       integer("run.threads", &Config::run_threads, 0, 1024,
               "threads (0: OMP_NUM_THREADS or all cores)"),
       boolean("run.fftw_measure", &Config::run_fftw_measure,
@@ -230,6 +314,15 @@ std::string known_sections() {
 
 void set_key(Config& c, const std::string& name, const toml::node& n) {
   const Key* k = find_key(name);
+  // a sub-key of a table-valued key (rod.perturbation_random.seed): set as a one-entry table
+  if (const auto dot = name.rfind('.'); !k && dot != std::string::npos && dot > name.find('.')) {
+    if (const Key* parent = find_key(name.substr(0, dot))) {
+      toml::table t;
+      t.insert(name.substr(dot + 1), n);
+      parent->set(c, t);
+      return;
+    }
+  }
   if (!k) {
     const std::string known = known_keys_in(section_of(name));
     if (name.find('.') == std::string::npos || known.empty())
@@ -242,6 +335,10 @@ void set_key(Config& c, const std::string& name, const toml::node& n) {
 }
 
 }  // namespace
+
+std::int64_t frame_every(const Config& c) {
+  return c.output_frame_every_steps < 0 ? c.output_every_steps : c.output_frame_every_steps;
+}
 
 void apply_toml(Config& c, const std::string& text, const std::string& source) {
   toml::table tbl;
@@ -375,7 +472,7 @@ sim::SimParams to_params(const Config& c) {
   s.threads = c.run_threads;
   s.plan_measure = c.run_fftw_measure;
   p.circle.excess_link = c.rod_excess_link;
-  p.circle.perturbation = c.rod_perturbation;
+  p.circle.perturbation = combined_perturbation(c.rod_perturbation, c.rod_perturbation_random);
   // the ring sits in the middle of the box
   p.circle.center = Vec3::Constant(0.5 * s.grid.L);
   p.t_end = c.time_t_end_us * us;
@@ -412,6 +509,13 @@ std::string derived_report(const Config& c) {
      << "time steps                = " << steps << "\n"
      << "diagnostics rows          = " << steps / p.output_every + 1 << "\n"
      << "memory estimate           = " << (fluid_bytes + 400.0 * s.rod.n) / (1 << 20) << " MiB\n";
+  // docs/outputs.md: checkpoint = 3 N³ velocities + 12 n rod numbers; a frame = 4 × n × 3 numbers
+  const std::int64_t fevery = frame_every(c);
+  const std::int64_t frames = fevery > 0 ? steps / fevery + 1 : 0;
+  os << "checkpoint size           = " << (24.0 * N3 + 96.0 * s.rod.n) / (1 << 20) << " MiB\n"
+     << "trajectory frames         = " << frames << " (H5MD ≈ "
+     << frames * 96.0 * s.rod.n / (1 << 20) << " MiB, .vtp ≈ "
+     << frames * 270.0 * s.rod.n / (1 << 20) << " MiB)\n";
   return os.str();
 }
 

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "io/perturbation.hpp"
 #include "sim/simulation.hpp"
 
 namespace ibrod::io {
@@ -24,6 +25,7 @@ struct Config {
   int rod_base_pairs = 600;        ///< rod.base_pairs: rod points n
   int rod_excess_link = 6;         ///< rod.excess_link: ΔLk (integer)
   std::vector<double> rod_perturbation{1.0};  ///< rod.perturbation: ε_m, m = 1, 2, …, rad
+  RandomPerturbation rod_perturbation_random;  ///< rod.perturbation_random: drawn ε_m, added
   double rod_rise_A = 3.4;         ///< rod.rise_A: Δs, Å
   double rod_bend_modulus_erg_cm = 1.3e-19;   ///< a1 = a2, erg·cm
   double rod_twist_modulus_erg_cm = 1.82e-19; ///< a3, erg·cm
@@ -46,13 +48,23 @@ struct Config {
   double steric_diameter_A = 20.0;      ///< D, Å
   double steric_stiffness_kT_A2 = 0;    ///< g, kT/Å²; set from interactions::kDefaultStericStiffness
   // [output]
-  std::int64_t output_every_steps = 1000;
+  std::int64_t output_every_steps = 1000;      ///< output.every_steps: steps between rows
+  std::int64_t output_frame_every_steps = -1;  ///< steps between trajectory frames; 0: none;
+                                               ///< −1: same as output.every_steps (frame_every())
+  std::int64_t output_checkpoint_every_steps = 10000;  ///< steps between checkpoints; 0: only at
+                                                       ///< start, end and on SIGINT/SIGTERM
+  bool output_fluid_vti = false;               ///< fluid velocity .vti with every frame
+  bool output_fluid_velocity = false;          ///< DIR/velocity.npy at the end (io/npy.hpp)
   // [run]
   int run_threads = 0;                  ///< 0: OpenMP default (OMP_NUM_THREADS or all cores)
   bool run_fftw_measure = true;         ///< FFTW_MEASURE plans (false: FFTW_ESTIMATE)
 
   Config();
 };
+
+/// Steps between trajectory frames (output.frame_every_steps resolved: −1 → output.every_steps);
+/// 0: no trajectory.
+std::int64_t frame_every(const Config& c);
 
 /// Parse a TOML document (file contents) on top of the defaults.
 void apply_toml(Config& c, const std::string& toml_text, const std::string& source_name);

@@ -1,22 +1,39 @@
 #pragma once
-// The run driver behind `ibrod run`: output directory, time loop, diagnostics rows, progress,
-// final state and summary. Files written into the output directory:
-//   config.toml       the resolved configuration (every key)
-//   timeseries.csv    one row per output step (columns: timeseries_header())
-//   final_state.csv   one row per rod point: x_A,y_A,z_A,d1x..d3z
-//   summary.json      steps, simulated time, why it stopped, final observables, timing
+// The run driver behind `ibrod run`: output directory, time loop, diagnostics rows, trajectory,
+// checkpoints, progress, final state and summary. Files written into the output directory
+// (docs/outputs.md describes each):
+//   config.toml        the resolved configuration (every key)
+//   timeseries.csv     one row per output step (columns: timeseries_header())
+//   trajectory.h5      H5MD trajectory: frames every output.frame_every_steps, observables, config
+//   rod.pvd, vtk/      ParaView series of the rod (.vtp), with every frame
+//   fluid.pvd          ParaView series of the fluid velocity (.vti; output.fluid_vti)
+//   checkpoint.bin     full state at the latest checkpoint (start, every
+//                      output.checkpoint_every_steps, end, SIGINT/SIGTERM)
+//   fftw.wisdom        the FFTW plans of the run (imported by --resume: same plans, same bits)
+//   final_state.csv    one row per rod point: x_A,y_A,z_A,d1x..d3z
+//   summary.json       steps, simulated time, why it stopped, link drift, observables, timing
+//
+// Continuing a run (--resume) from its checkpoint at step C drops every row and frame after C
+// and recomputes them; the result is bitwise identical to a run that was never interrupted
+// (same plans through fftw.wisdom, the same thread count, deterministic reductions).
 #include <cstdio>
 #include <string>
 
 #include "io/config.hpp"
+#include "io/observables.hpp"
 #include "sim/simulation.hpp"
 
 namespace ibrod::io {
 
 struct RunOptions {
   std::string output_dir = "ibrod-out";
-  bool overwrite = false;  ///< replace an existing, non-empty output directory
-  std::FILE* log = stdout; ///< progress lines (nullptr: silent)
+  bool overwrite = false;     ///< replace the files of an existing, non-empty output directory
+  bool resume = false;        ///< continue the run in output_dir from its checkpoint.bin
+  bool force = false;         ///< resume even if the configuration differs from the checkpoint's
+  std::string fftw_wisdom;    ///< import these FFTW plans before planning ("": none)
+  bool handle_signals = true; ///< SIGINT/SIGTERM: checkpoint at the end of the step, then return
+  std::FILE* log = stdout;    ///< progress lines and warnings (nullptr: silent)
+  int tty = -1;               ///< progress style: 1 in place ('\r'), 0 plain lines, −1 isatty(log)
 };
 
 struct RunResult {
@@ -24,17 +41,27 @@ struct RunResult {
   double time_us = 0;
   sim::StopReason reason = sim::StopReason::none;
   sim::Observables initial, final;
-  double wall_s = 0;
-  double ms_per_step = 0;
+  double wall_s = 0;          ///< this process
+  double ms_per_step = 0;     ///< this process
+  int signal = 0;             ///< SIGINT/SIGTERM that stopped the run after a checkpoint; 0: none
+  bool already_finished = false;  ///< --resume of a run that had stopped: nothing was done
+  std::int64_t resumed_from = -1; ///< checkpoint step this process started from (−1: fresh)
+  std::int64_t checkpoint_step = -1;  ///< step of the latest checkpoint written or read
+  double link_drift = 0;      ///< final Lk − initial Lk
+  double max_link_drift = 0;  ///< max |Lk − Lk(0)| over the output steps
+  bool self_passage_warning = false;  ///< max_link_drift > kLinkDriftWarning
 };
 
-/// Run one trajectory. Throws ConfigError (bad config, output directory exists) or RunError
-/// (non-finite state, I/O failure).
+/// |Lk − Lk(0)| beyond which a run warns (once) of a likely self-passage.
+inline constexpr double kLinkDriftWarning = 0.1;
+
+/// Run (or, with opt.resume, continue) one trajectory. Throws ConfigError (bad config, output
+/// directory exists, unusable checkpoint) or RunError (blow-up, I/O failure: disk full, …).
+/// A SIGINT/SIGTERM does not throw: the result has signal set.
 RunResult run(const Config& c, const RunOptions& opt);
 
-/// The header row of timeseries.csv.
-std::string timeseries_header();
-/// One row of timeseries.csv (no newline).
-std::string timeseries_row(const sim::Observables& o);
+/// Empty if the rod is sane; otherwise what is wrong, naming the point: a non-finite position or
+/// triad, an adjacent spacing off Δs by more than 50 %, a triad off orthonormal by more than 1e-3.
+std::string rod_problem(const rod::RodState& s, double ds);
 
 }  // namespace ibrod::io

@@ -43,7 +43,11 @@ class Simulation {
   const rod::RodState& rod() const { return rod_; }
   rod::RodState& rod() { return rod_; }
   integrate::Stepper& stepper() { return stepper_; }
+  const integrate::Stepper& stepper() const { return stepper_; }
   std::int64_t step_count() const { return step_; }
+  /// Sets the step counter (and so time()) when a checkpoint restores rod() and the fluid
+  /// velocity; nothing else of the state depends on it.
+  void restore_step_count(std::int64_t step) { step_ = step; }
   double time() const { return step_ * p_.stepper.fluid.dt; }  ///< s
 
   /// One time step.

@@ -1,0 +1,96 @@
+// `ibrod analyze` and `ibrod render` (cmd_analysis.hpp); the work is in io/analyze.hpp.
+#include "cmd_analysis.hpp"
+
+#include <cstdio>
+#include <exception>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/error.hpp"
+#include "io/analyze.hpp"
+#include "render/render.hpp"
+
+namespace {
+
+/// Runs a subcommand's work and ends parsing with its exit status (cmd_analysis.hpp).
+[[noreturn]] void finish(const std::function<void()>& work) {
+  int status = 0;
+  try {
+    work();
+  } catch (const ibrod::ConfigError& e) {
+    std::fprintf(stderr, "ibrod: error: %s\n", e.what());
+    status = 2;
+  } catch (const ibrod::RunError& e) {
+    std::fprintf(stderr, "ibrod: error: %s\n", e.what());
+    status = 3;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "ibrod: error: %s\n", e.what());
+    status = 1;
+  }
+  std::fflush(stdout);
+  throw CLI::RuntimeError(status);
+}
+
+std::string join(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& x : v) s += (s.empty() ? "" : ",") + x;
+  return s;
+}
+
+}  // namespace
+
+void add_analysis_commands(CLI::App& app) {
+  // ---- analyze
+  struct AnalyzeArgs {
+    std::string dir;
+    ibrod::io::AnalyzeOptions opt;
+    bool quiet = false;
+  };
+  auto a = std::make_shared<AnalyzeArgs>();
+  auto* analyze = app.add_subcommand(
+      "analyze", "add the time-series analysis (writhe convergence, relaxation time τ, transient "
+                 "states, power law) to DIR/summary.json; see docs/analysis.md");
+  analyze->add_option("dir", a->dir, "run directory (written by ibrod run)")->required();
+  analyze->add_option("--delta", a->opt.writhe_delta,
+                      "band |Wr − Wr(∞)| of the writhe convergence time")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  analyze->add_option("--fit-tolerance", a->opt.fit.tolerance,
+                      "largest |residual| of ln E_K in a fit window (0.02: 2 %)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  analyze->add_flag("-q,--quiet", a->quiet, "print nothing on success");
+  analyze->callback([a] {
+    finish([&] {
+      const auto result = ibrod::io::analyze_run(a->dir, a->opt);
+      if (!a->quiet) std::printf("%s\n", ibrod::io::analysis_json(result, a->opt).c_str());
+    });
+  });
+
+  // ---- render
+  struct RenderArgs {
+    std::string dir, size = "800x800";
+    ibrod::io::RenderOptions opt;
+  };
+  auto r = std::make_shared<RenderArgs>();
+  auto* render = app.add_subcommand(
+      "render", "draw the rod as a shaded tube with a stripe along D1 into DIR/render/*.png");
+  render->add_option("dir", r->dir, "run directory (written by ibrod run)")->required();
+  render->add_option("--time", r->opt.times,
+                     "time in µs (nearest frame of DIR/trajectory.h5) or 'final'; repeatable or "
+                     "comma-separated (default: final)")
+      ->delimiter(',');
+  render->add_option("--views", r->opt.views,
+                     "comma-separated, of: " + join(ibrod::render::standard_view_names()))
+      ->delimiter(',')
+      ->default_str(join(r->opt.views));
+  render->add_option("--size", r->size, "image size WxH in pixels")->capture_default_str();
+  render->callback([r] {
+    finish([&] {
+      ibrod::io::parse_size(r->size, r->opt.width, r->opt.height);
+      ibrod::io::render_run(r->dir, r->opt, stdout);
+    });
+  });
+}

@@ -1,0 +1,91 @@
+// `ibrod sweep` (cmd_sweep.hpp); the work is in io/sweep.hpp.
+#include "cmd_sweep.hpp"
+
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "core/error.hpp"
+#include "io/mpi_env.hpp"
+#include "io/sweep.hpp"
+
+namespace {
+
+struct SweepArgs {
+  std::string file, output;
+  int jobs = 1;
+  bool list = false;
+};
+
+int sweep_main(const SweepArgs& a) {
+  namespace fs = std::filesystem;
+  // MPI only under a launcher; the ranks share the points, each spawns plain `ibrod run`s
+  const ibrod::io::mpi::World world = ibrod::io::mpi::init(nullptr, nullptr);
+  struct Finalize {
+    const ibrod::io::mpi::World& w;
+    ~Finalize() { ibrod::io::mpi::finalize(w); }
+  } finalize{world};
+  const bool root = world.rank == 0;
+  int status = 0;
+  try {
+    const ibrod::io::Sweep sw = ibrod::io::load_sweep(a.file);
+    ibrod::io::SweepOptions opt;
+    opt.output_root = !a.output.empty()          ? fs::path(a.output)
+                      : !sw.output_root.empty() ? fs::path(sw.output_root)
+                                                : fs::path(fs::path(a.file).stem());
+    if (a.list) {
+      if (root)
+        for (const auto& pt : sw.points)
+          std::printf("%-40s %s\n", pt.name.c_str(),
+                      ibrod::io::to_string(ibrod::io::point_state(opt.output_root / pt.name)));
+      return 0;
+    }
+    opt.jobs = a.jobs;
+    opt.rank = world.rank;
+    opt.ranks = world.size;
+    const ibrod::io::SweepReport r = ibrod::io::run_sweep(sw, opt);
+    for (const auto& name : r.failed_names)
+      std::fprintf(stderr, "ibrod: sweep: point %s failed\n", name.c_str());
+    // collectives in the same order on every rank
+    const long long failed = ibrod::io::mpi::sum(r.failed);
+    const long long sig = ibrod::io::mpi::max(r.signal);
+    const long long points = ibrod::io::mpi::sum(r.points);
+    const long long completed = ibrod::io::mpi::sum(r.completed);
+    const long long skipped = ibrod::io::mpi::sum(r.skipped);
+    if (world.size > 1 && root)
+      std::printf("sweep: all ranks: %lld points, %lld finished now, %lld already finished, %lld "
+                  "failed\n",
+                  points, completed, skipped, failed);
+    status = sig ? 128 + int(sig) : failed > 0 ? 4 : 0;
+  } catch (const ibrod::ConfigError& e) {
+    if (root) std::fprintf(stderr, "ibrod: error: %s\n", e.what());
+    status = 2;
+  } catch (const ibrod::RunError& e) {
+    std::fprintf(stderr, "ibrod: error: %s\n", e.what());
+    status = 3;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "ibrod: error: %s\n", e.what());
+    status = 1;
+  }
+  std::fflush(stdout);
+  return status;
+}
+
+}  // namespace
+
+void add_sweep_command(CLI::App& app) {
+  auto a = std::make_shared<SweepArgs>();
+  auto* sweep = app.add_subcommand(
+      "sweep", "run every point of a parameter sweep (SWEEP.toml: a config plus [sweep] lists)");
+  sweep->add_option("sweep_file", a->file, "sweep file (docs/sweeps.md)")->required();
+  sweep->add_option("-j,--jobs", a->jobs, "ibrod run processes at a time (per MPI rank)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  sweep->add_option("-o,--output", a->output,
+                    "root of the point directories (default: `output_dir` of the sweep file, else "
+                    "the sweep file's name without .toml)");
+  sweep->add_flag("--list", a->list, "print every point's name and state, run nothing");
+  sweep->callback([a] { throw CLI::RuntimeError(sweep_main(*a)); });
+}

@@ -1,0 +1,240 @@
+#include "io/checkpoint.hpp"
+
+#include <array>
+#include <bit>
+#include <cstring>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "core/error.hpp"
+#include "io/atomic_file.hpp"
+#include "io/observables.hpp"
+
+namespace ibrod::io {
+
+static_assert(std::endian::native == std::endian::little,
+              "checkpoints are little-endian; add byte swapping for this host");
+
+namespace {
+
+constexpr char kMagic[8] = {'I', 'B', 'R', 'O', 'D', 'C', 'K', 'P'};
+constexpr std::uint32_t kByteOrderMark = 0x01020304u;
+constexpr std::size_t kHeaderBytes = 32;
+
+struct Header {
+  char magic[8];
+  std::uint32_t version;
+  std::uint32_t byte_order;
+  std::uint64_t payload_bytes;
+  std::uint32_t crc;
+  std::uint32_t zero;
+};
+static_assert(sizeof(Header) == kHeaderBytes);
+
+constexpr std::array<std::uint32_t, 256> make_crc_table() {
+  std::array<std::uint32_t, 256> t{};
+  for (std::uint32_t i = 0; i < 256; ++i) {
+    std::uint32_t c = i;
+    for (int k = 0; k < 8; ++k) c = (c & 1u) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+    t[i] = c;
+  }
+  return t;
+}
+constexpr auto kCrcTable = make_crc_table();
+
+nlohmann::ordered_json observables_json(const sim::Observables& o) {
+  nlohmann::ordered_json j;
+  j["step"] = o.step;
+  j["time_us"] = o.time_us;
+  for (const auto& f : observable_fields()) j[f.name] = o.*f.member;
+  return j;
+}
+
+sim::Observables observables_from(const nlohmann::json& j) {
+  sim::Observables o;
+  o.step = j.at("step").get<std::int64_t>();
+  o.time_us = j.at("time_us").get<double>();
+  for (const auto& f : observable_fields())
+    o.*f.member = j.at(f.name).is_null() ? std::numeric_limits<double>::quiet_NaN()
+                                         : j.at(f.name).get<double>();
+  return o;
+}
+
+std::string meta_json(const CheckpointMeta& m) {
+  nlohmann::ordered_json j;
+  j["step"] = m.step;
+  j["threads"] = m.threads;
+  j["stop_reason"] = m.stop_reason;
+  j["self_passage_warning"] = m.self_passage_warning;
+  j["self_passage_step"] = m.self_passage_step;
+  j["max_link_drift"] = m.max_link_drift;
+  j["wall_s"] = m.wall_s;
+  j["resumes"] = m.resumes;
+  j["initial"] = observables_json(m.initial);
+  j["config_toml"] = m.config_toml;
+  return j.dump();  // doubles with 17 significant digits: they read back exactly
+}
+
+CheckpointMeta meta_from(const std::string& text) {
+  const nlohmann::json j = nlohmann::json::parse(text);
+  CheckpointMeta m;
+  m.step = j.at("step").get<std::int64_t>();
+  m.threads = j.at("threads").get<int>();
+  m.stop_reason = j.at("stop_reason").get<std::string>();
+  m.self_passage_warning = j.at("self_passage_warning").get<bool>();
+  m.self_passage_step = j.at("self_passage_step").get<std::int64_t>();
+  m.max_link_drift = j.at("max_link_drift").get<double>();
+  m.wall_s = j.at("wall_s").get<double>();
+  m.resumes = j.at("resumes").get<std::int64_t>();
+  m.initial = observables_from(j.at("initial"));
+  m.config_toml = j.at("config_toml").get<std::string>();
+  return m;
+}
+
+// Writes payload pieces and keeps the running CRC and size.
+struct PayloadWriter {
+  AtomicFile& f;
+  std::uint32_t crc = 0;
+  std::uint64_t bytes = 0;
+  void put(const void* p, std::size_t n) {
+    f.write(p, n);
+    crc = crc32(p, n, crc);
+    bytes += n;
+  }
+  template <class T>
+  void put_value(T v) {
+    put(&v, sizeof v);
+  }
+};
+
+// Reads payload pieces, throwing "truncated" past the end.
+struct PayloadReader {
+  const char* p;
+  std::size_t left;
+  const std::string& name;
+  void get(void* out, std::size_t n) {
+    if (n > left)
+      throw ConfigError("checkpoint " + name + " is inconsistent: its payload ends early");
+    std::memcpy(out, p, n);
+    p += n;
+    left -= n;
+  }
+  template <class T>
+  T get_value() {
+    T v;
+    get(&v, sizeof v);
+    return v;
+  }
+};
+
+}  // namespace
+
+std::uint32_t crc32(const void* data, std::size_t bytes, std::uint32_t crc) {
+  const auto* p = static_cast<const unsigned char*>(data);
+  crc = ~crc;
+  for (std::size_t i = 0; i < bytes; ++i) crc = kCrcTable[(crc ^ p[i]) & 0xFFu] ^ (crc >> 8);
+  return ~crc;
+}
+
+void write_checkpoint(const std::filesystem::path& path, const CheckpointMeta& meta,
+                      const rod::RodState& rod, int grid_n, std::array<const double*, 3> u) {
+  AtomicFile f(path);
+  Header h{};
+  std::memcpy(h.magic, kMagic, sizeof kMagic);
+  h.version = kCheckpointVersion;
+  h.byte_order = kByteOrderMark;
+  f.write(&h, sizeof h);  // placeholder: size and CRC are known at the end
+
+  PayloadWriter w{f};
+  const std::string json = meta_json(meta);
+  w.put_value<std::uint64_t>(json.size());
+  w.put(json.data(), json.size());
+  const std::int64_t n = rod.size();
+  w.put_value<std::int64_t>(n);
+  for (const Vec3& x : rod.X) w.put(x.data(), 3 * sizeof(double));
+  for (const Mat3& d : rod.D) w.put(d.data(), 9 * sizeof(double));  // column-major: D¹, D², D³
+  w.put_value<std::int64_t>(grid_n);
+  const std::size_t n3 = std::size_t(grid_n) * grid_n * grid_n;
+  for (int c = 0; c < 3; ++c) w.put(u[c], n3 * sizeof(double));
+
+  h.payload_bytes = w.bytes;
+  h.crc = w.crc;
+  f.write_at(0, &h, sizeof h);
+  f.commit(/*durable=*/true);
+}
+
+Checkpoint read_checkpoint(const std::filesystem::path& path) {
+  const std::string name = path.string();
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) throw ConfigError("checkpoint " + name + " cannot be read (missing or no permission)");
+  const std::streamoff size = in.tellg();
+  in.seekg(0);
+  std::vector<char> buf(std::size_t(std::max<std::streamoff>(size, 0)));
+  if (!in.read(buf.data(), std::streamsize(buf.size())))
+    throw ConfigError("checkpoint " + name + " cannot be read");
+
+  Header h{};
+  if (buf.size() < kHeaderBytes || std::memcmp(buf.data(), kMagic, sizeof kMagic) != 0) {
+    if (buf.size() >= sizeof kMagic && std::memcmp(buf.data(), kMagic, sizeof kMagic) == 0)
+      throw ConfigError("checkpoint " + name + " is truncated: " + std::to_string(buf.size()) +
+                        " bytes, shorter than its header");
+    throw ConfigError("checkpoint " + name + " is not an ibrod checkpoint (no IBRODCKP header)");
+  }
+  std::memcpy(&h, buf.data(), sizeof h);
+  if (h.byte_order != kByteOrderMark)
+    throw ConfigError("checkpoint " + name + " was written on a machine of another byte order");
+  if (h.version != kCheckpointVersion)
+    throw ConfigError("checkpoint " + name + " has format version " + std::to_string(h.version) +
+                      "; this ibrod reads version " + std::to_string(kCheckpointVersion));
+  const std::uint64_t have = buf.size() - kHeaderBytes;
+  if (have < h.payload_bytes)
+    throw ConfigError("checkpoint " + name + " is truncated: " + std::to_string(buf.size()) +
+                      " bytes, the header announces " +
+                      std::to_string(h.payload_bytes + kHeaderBytes));
+  if (have > h.payload_bytes)
+    throw ConfigError("checkpoint " + name + " is corrupt: " + std::to_string(buf.size()) +
+                      " bytes, the header announces " +
+                      std::to_string(h.payload_bytes + kHeaderBytes));
+  const char* payload = buf.data() + kHeaderBytes;
+  const std::uint32_t crc = crc32(payload, h.payload_bytes);
+  if (crc != h.crc) {
+    char msg[160];
+    std::snprintf(msg, sizeof msg, " is corrupt: CRC-32 of the payload is %08x, the header says %08x",
+                  crc, h.crc);
+    throw ConfigError("checkpoint " + name + msg);
+  }
+
+  // The checksum holds: from here on a failure means a writer bug, still reported, never UB.
+  PayloadReader r{payload, std::size_t(h.payload_bytes), name};
+  Checkpoint ck;
+  const auto json_bytes = r.get_value<std::uint64_t>();
+  if (json_bytes > r.left) throw ConfigError("checkpoint " + name + " is inconsistent: bad meta size");
+  std::string json(json_bytes, '\0');
+  r.get(json.data(), json.size());
+  try {
+    ck.meta = meta_from(json);
+  } catch (const nlohmann::json::exception& e) {
+    throw ConfigError("checkpoint " + name + " has unreadable metadata: " + e.what());
+  }
+  const auto n = r.get_value<std::int64_t>();
+  if (n < 0 || std::uint64_t(n) > r.left / (12 * sizeof(double)))
+    throw ConfigError("checkpoint " + name + " is inconsistent: bad rod size " + std::to_string(n));
+  ck.rod.X.resize(std::size_t(n));
+  ck.rod.D.resize(std::size_t(n));
+  for (Vec3& x : ck.rod.X) r.get(x.data(), 3 * sizeof(double));
+  for (Mat3& d : ck.rod.D) r.get(d.data(), 9 * sizeof(double));
+  const auto gn = r.get_value<std::int64_t>();
+  if (gn < 1 || gn > 1 << 14)
+    throw ConfigError("checkpoint " + name + " is inconsistent: bad grid size " + std::to_string(gn));
+  ck.grid_n = int(gn);
+  const std::size_t values = 3 * std::size_t(gn) * std::size_t(gn) * std::size_t(gn);
+  if (values * sizeof(double) != r.left)
+    throw ConfigError("checkpoint " + name + " is inconsistent: the fluid block has " +
+                      std::to_string(r.left) + " bytes, a " + std::to_string(gn) +
+                      "³ grid needs " + std::to_string(values * sizeof(double)));
+  ck.velocity.resize(values);
+  r.get(ck.velocity.data(), values * sizeof(double));
+  return ck;
+}
+
+}  // namespace ibrod::io

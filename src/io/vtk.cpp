@@ -1,0 +1,180 @@
+#include "io/vtk.hpp"
+
+#include <cstdio>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "io/atomic_file.hpp"
+
+namespace ibrod::io {
+namespace fs = std::filesystem;
+
+namespace {
+
+void append_fmt(std::string& out, const char* fmt, double a) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, fmt, a);
+  out += buf;
+}
+
+// One DataArray of `comps` components: values(k, c) for k < count.
+template <class F>
+void data_array(std::string& out, const char* type, const char* name, int comps, std::size_t count,
+                F&& value, const char* fmt = "%.10g") {
+  out += "        <DataArray type=\"";
+  out += type;
+  out += "\"";
+  if (name) {
+    out += " Name=\"";
+    out += name;
+    out += "\"";
+  }
+  out += " NumberOfComponents=\"" + std::to_string(comps) + "\" format=\"ascii\">\n";
+  for (std::size_t k = 0; k < count; ++k) {
+    out += "         ";
+    for (int c = 0; c < comps; ++c) {
+      out += ' ';
+      append_fmt(out, fmt, value(k, c));
+    }
+    out += '\n';
+  }
+  out += "        </DataArray>\n";
+}
+
+// Ω³ at the half point k+½ (MODEL §4 strains): (D¹_{k+1} − D¹_k)/Δs · D²_{k+½}, rad/Å.
+double twist_density(const Mat3& Dk, const Mat3& Dk1, double ds) {
+  const Mat3 Dh = rod::half_point_triad(Dk, Dk1);
+  return ((Dk1.col(0) - Dk.col(0)) / ds).dot(Dh.col(1));
+}
+
+}  // namespace
+
+std::string rod_vtp(const rod::RodState& s, double ds_A) {
+  const int n = s.size();
+  std::vector<double> omega(n), strain(n);
+  for (int k = 0; k < n; ++k) {
+    const int k1 = k + 1 == n ? 0 : k + 1;
+    omega[k] = twist_density(s.D[k], s.D[k1], ds_A);  // half point k+½
+    strain[k] = (s.X[k1] - s.X[k]).norm() / ds_A - 1.0;
+  }
+  std::string out;
+  out.reserve(std::size_t(n) * 260 + 1024);
+  out += "<?xml version=\"1.0\"?>\n"
+         "<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" "
+         "header_type=\"UInt64\">\n"
+         "  <PolyData>\n";
+  out += "    <Piece NumberOfPoints=\"" + std::to_string(n) +
+         "\" NumberOfVerts=\"0\" NumberOfLines=\"1\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n";
+  out += "      <PointData Scalars=\"twist_density_rad_per_A\" Vectors=\"d3\">\n";
+  const char* const triad_names[3] = {"d1", "d2", "d3"};
+  for (int c = 0; c < 3; ++c) {
+    data_array(out, "Float64", triad_names[c], 3, n,
+               [&](std::size_t k, int i) { return s.D[k](i, c); });
+  }
+  data_array(out, "Float64", "twist_density_rad_per_A", 1, n, [&](std::size_t k, int) {
+    return 0.5 * (omega[k] + omega[k == 0 ? n - 1 : k - 1]);
+  });
+  data_array(out, "Float64", "stretch_strain", 1, n,
+             [&](std::size_t k, int) { return strain[k]; });
+  out += "      </PointData>\n      <Points>\n";
+  data_array(out, "Float64", "Points", 3, n, [&](std::size_t k, int i) { return s.X[k][i]; });
+  out += "      </Points>\n      <Lines>\n";
+  // closed polyline: the first point again at the end
+  data_array(out, "Int64", "connectivity", 1, std::size_t(n) + 1,
+             [&](std::size_t k, int) { return double(k == std::size_t(n) ? 0 : k); }, "%.0f");
+  data_array(out, "Int64", "offsets", 1, 1, [&](std::size_t, int) { return double(n + 1); },
+             "%.0f");
+  out += "      </Lines>\n    </Piece>\n  </PolyData>\n</VTKFile>\n";
+  return out;
+}
+
+std::string fluid_vti(const GridSpec& g, std::array<const double*, 3> u) {
+  const int n = g.n;
+  const double h = g.h();
+  char hdr[512];
+  std::snprintf(hdr, sizeof hdr,
+                "<?xml version=\"1.0\"?>\n"
+                "<VTKFile type=\"ImageData\" version=\"1.0\" byte_order=\"LittleEndian\" "
+                "header_type=\"UInt64\">\n"
+                "  <ImageData WholeExtent=\"0 %d 0 %d 0 %d\" Origin=\"0 0 0\" "
+                "Spacing=\"%.17g %.17g %.17g\">\n"
+                "    <Piece Extent=\"0 %d 0 %d 0 %d\">\n"
+                "      <PointData Vectors=\"velocity_A_per_ns\">\n",
+                n - 1, n - 1, n - 1, h, h, h, n - 1, n - 1, n - 1);
+  std::string out = hdr;
+  out.reserve(g.size() * 3 * 16 + 1024);
+  // VTK image order: x fastest; ibrod's grid: z fastest (GridSpec::index)
+  data_array(
+      out, "Float64", "velocity_A_per_ns", 3, g.size(),
+      [&](std::size_t p, int c) {
+        const int i = int(p % std::size_t(n));
+        const int j = int((p / std::size_t(n)) % std::size_t(n));
+        const int k = int(p / (std::size_t(n) * std::size_t(n)));
+        return u[c][g.index(i, j, k)] * 1e-9;  // Å/s → Å/ns
+      },
+      "%.8g");
+  out += "      </PointData>\n      <CellData>\n      </CellData>\n    </Piece>\n"
+         "  </ImageData>\n</VTKFile>\n";
+  return out;
+}
+
+PvdSeries::PvdSeries(fs::path dir, std::string prefix, std::string ext)
+    : dir_(std::move(dir)), prefix_(std::move(prefix)), ext_(std::move(ext)) {}
+
+void PvdSeries::resume(std::int64_t last_step) {
+  entries_.clear();
+  const std::regex file_re(prefix_ + "_([0-9]+)\\." + ext_ + "$");
+  std::ifstream in(dir_ / (prefix_ + ".pvd"));
+  const std::regex line_re("<DataSet timestep=\"([^\"]*)\"[^>]*file=\"([^\"]*)\"");
+  std::string line;
+  std::smatch m, f;
+  while (std::getline(in, line)) {
+    if (!std::regex_search(line, m, line_re)) continue;
+    const std::string file = m[2];
+    if (!std::regex_search(file, f, file_re)) continue;
+    const std::int64_t step = std::stoll(f[1]);
+    if (step > last_step || (!entries_.empty() && step <= entries_.back().step)) continue;
+    if (!fs::exists(dir_ / file)) continue;
+    entries_.push_back({step, std::strtod(std::string(m[1]).c_str(), nullptr), file});
+  }
+  // files of later frames would be stale
+  std::error_code ec;
+  if (fs::is_directory(dir_ / "vtk", ec))
+    for (const auto& e : fs::directory_iterator(dir_ / "vtk", ec)) {
+      const std::string name = e.path().filename().string();
+      if (std::regex_match(name, f, std::regex(prefix_ + "_([0-9]+)\\." + ext_)) &&
+          std::stoll(f[1]) > last_step)
+        fs::remove(e.path(), ec);
+    }
+  write_pvd();
+}
+
+void PvdSeries::add(std::int64_t step, double time_us, const std::string& xml) {
+  char name[96];
+  std::snprintf(name, sizeof name, "vtk/%s_%06lld.%s", prefix_.c_str(),
+                static_cast<long long>(step), ext_.c_str());
+  std::error_code ec;
+  fs::create_directories(dir_ / "vtk", ec);
+  write_file_atomic(dir_ / name, xml);
+  entries_.push_back({step, time_us, name});
+  write_pvd();
+}
+
+void PvdSeries::write_pvd() const {
+  std::string out =
+      "<?xml version=\"1.0\"?>\n"
+      "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+      "  <Collection>\n";
+  char buf[256];
+  for (const Entry& e : entries_) {
+    std::snprintf(buf, sizeof buf, "    <DataSet timestep=\"%.17g\" group=\"\" part=\"0\" file=\"%s\"/>\n",
+                  e.time_us, e.file.c_str());
+    out += buf;
+  }
+  out += "  </Collection>\n</VTKFile>\n";
+  write_file_atomic(dir_ / (prefix_ + ".pvd"), out);
+}
+
+}  // namespace ibrod::io

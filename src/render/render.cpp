@@ -1,0 +1,192 @@
+// Ray casting of the rod as a chain of capsules (render.hpp).
+#include "render/render.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace ibrod::render {
+
+namespace {
+
+struct Hit {
+  double t;  ///< distance along the ray
+  double h;  ///< position of the nearest axis point along the segment, in [0, 1]
+};
+
+/// Nearest intersection (t ≥ 0) of the ray ro + t rd (|rd| = 1) with the capsule of radius r about
+/// a → b, or t < 0 for a miss. Cylinder by the quadratic in t restricted to the segment's slab,
+/// then the sphere cap on the side the cylinder hit fell (I. Quilez's capsule intersection).
+Hit ray_capsule(const Vec3& ro, const Vec3& rd, const Vec3& a, const Vec3& b, double r) {
+  const Vec3 ba = b - a, oa = ro - a;
+  const double baba = ba.dot(ba), bard = ba.dot(rd), baoa = ba.dot(oa), rdoa = rd.dot(oa),
+               oaoa = oa.dot(oa);
+  const double qa = baba - bard * bard, qb = baba * rdoa - baoa * bard,
+               qc = baba * oaoa - baoa * baoa - r * r * baba;
+  double h = qb * qb - qa * qc;
+  if (h < 0) return {-1, 0};
+  double t = qa > 0 ? (-qb - std::sqrt(h)) / qa : -1;  // qa = 0: the ray runs along the axis
+  const double y = baoa + t * bard;
+  if (qa > 0 && y > 0 && y < baba) return {t, y / baba};
+  // sphere cap at a (y ≤ 0) or at b
+  const Vec3 oc = (y <= 0) ? oa : Vec3(ro - b);
+  const double sb = rd.dot(oc), sc = oc.dot(oc) - r * r;
+  h = sb * sb - sc;
+  if (h <= 0) return {-1, 0};
+  return {-sb - std::sqrt(h), y <= 0 ? 0.0 : 1.0};
+}
+
+std::uint8_t to_byte(double v) { return std::uint8_t(std::clamp(std::lround(v), 0L, 255L)); }
+
+}  // namespace
+
+std::vector<std::string> standard_view_names() { return {"top", "bottom", "side", "front", "oblique"}; }
+
+View standard_view(const std::string& name) {
+  if (name == "top") return {name, {0, 0, -1}, {0, 1, 0}};
+  if (name == "bottom") return {name, {0, 0, 1}, {0, 1, 0}};
+  if (name == "side") return {name, {0, 1, 0}, {0, 0, 1}};
+  if (name == "front") return {name, {-1, 0, 0}, {0, 0, 1}};
+  if (name == "oblique") return {name, -Vec3(0.55, -0.8, 0.75).normalized(), {0, 0, 1}};
+  std::string all;
+  for (const auto& n : standard_view_names()) all += (all.empty() ? "" : ", ") + n;
+  throw std::invalid_argument("unknown view '" + name + "' (one of: " + all + ")");
+}
+
+Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diameter,
+                 const View& view, int width, int height, const Style& style) {
+  const std::size_t n = X.size();
+  if (n < 2) throw std::invalid_argument("render_rod: needs at least 2 points");
+  if (d1.size() != n)
+    throw std::invalid_argument("render_rod: " + std::to_string(d1.size()) + " directors for " +
+                                std::to_string(n) + " points");
+  if (!(diameter > 0)) throw std::invalid_argument("render_rod: diameter must be positive");
+  if (width <= 0 || height <= 0)
+    throw std::invalid_argument("render_rod: image size " + std::to_string(width) + "x" +
+                                std::to_string(height) + " is not positive");
+  const int S = std::max(1, style.supersample);
+  const int W = width * S, H = height * S;
+
+  // camera frame: forward f, right r = f × up, true up u = r × f
+  const Vec3 f = view.forward.normalized();
+  const Vec3 right = f.cross(view.up);
+  if (!(right.norm() > 1e-9 * view.up.norm()))
+    throw std::invalid_argument("render_rod: view '" + view.name + "': up is parallel to forward");
+  const Vec3 r = right.normalized();
+  const Vec3 u = r.cross(f);
+  const double R = 0.5 * diameter;
+
+  // centre and scale: the tube's bounding sphere fills the image less the margins
+  Vec3 c = Vec3::Zero();
+  for (const auto& x : X) c += x;
+  c /= double(n);
+  double rho = 0;
+  for (const auto& x : X) rho = std::max(rho, (x - c).norm());
+  rho += R;
+  const double usable = 0.5 * std::min(W, H) * (1 - 2 * style.margin);
+  const double scale = usable / rho;  // pixels (supersampled) per length unit
+  const Vec3 eye = c - 2 * rho * f;   // rays start on a plane in front of everything
+
+  // light from the upper left, in front of the rod
+  const Vec3 light = (-0.45 * r + 0.6 * u - 0.65 * f).normalized();
+
+  std::vector<double> depth(std::size_t(W) * std::size_t(H), std::numeric_limits<double>::infinity());
+  std::vector<float> shade(depth.size(), 0.0f);
+  std::vector<std::uint8_t> on_stripe(depth.size(), 0);
+
+  // vertex tangents (central differences), blended along each segment for smooth shading
+  std::vector<Vec3> vtan(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const Vec3 d = X[(k + 1) % n] - X[(k + n - 1) % n];
+    vtan[k] = d.norm() > 0 ? Vec3(d.normalized()) : Vec3(f);
+  }
+
+  for (std::size_t k = 0; k < n; ++k) {
+    const Vec3& a = X[k];
+    const Vec3& b = X[(k + 1) % n];
+    const Vec3 ab = b - a;
+    const double len = ab.norm();
+    const Vec3 tan = len > 0 ? Vec3(ab / len) : Vec3(f);
+    // the segment's screen box, grown by the radius
+    const double ax = (a - c).dot(r) * scale, ay = (a - c).dot(u) * scale;
+    const double bx = (b - c).dot(r) * scale, by = (b - c).dot(u) * scale;
+    const double pad = R * scale + 1;
+    const int x0 = std::max(0, int(std::floor(0.5 * W + std::min(ax, bx) - pad)));
+    const int x1 = std::min(W - 1, int(std::ceil(0.5 * W + std::max(ax, bx) + pad)));
+    const int y0 = std::max(0, int(std::floor(0.5 * H - std::max(ay, by) - pad)));
+    const int y1 = std::min(H - 1, int(std::ceil(0.5 * H - std::min(ay, by) + pad)));
+    for (int py = y0; py <= y1; ++py) {
+      for (int px = x0; px <= x1; ++px) {
+        const double sx = (px + 0.5 - 0.5 * W) / scale, sy = (0.5 * H - (py + 0.5)) / scale;
+        const Vec3 ro = eye + sx * r + sy * u;
+        const Hit hit = ray_capsule(ro, f, a, b, R);
+        const std::size_t idx = std::size_t(py) * std::size_t(W) + std::size_t(px);
+        if (hit.t < 0 || hit.t >= depth[idx]) continue;
+        depth[idx] = hit.t;
+        const Vec3 p = ro + hit.t * f;
+        const Vec3 axis = a + hit.h * ab;
+        const Vec3 nrm = (p - axis).normalized();
+        // D¹ along the segment, ⟂ to its tangent
+        Vec3 d = (1 - hit.h) * d1[k] + hit.h * d1[(k + 1) % n];
+        d -= d.dot(tan) * tan;
+        // compare directions ⟂ to the axis, with the tangent blended between the vertices (on
+        // a cap the normal also leans along the axis; a polygonal tube would look faceted)
+        Vec3 tb = (1 - hit.h) * vtan[k] + hit.h * vtan[(k + 1) % n];
+        tb = tb.norm() > 1e-12 ? Vec3(tb.normalized()) : tan;
+        const Vec3 np = nrm - nrm.dot(tb) * tb;
+        const double dn = d.norm() * np.norm();
+        on_stripe[idx] = dn > 0 && np.dot(d) / dn > style.stripe_cos;
+        // shade with the same ⟂ normal (Phong-like smoothing across the joints)
+        const Vec3 ns = np.norm() > 1e-12 ? Vec3(np.normalized()) : nrm;
+        shade[idx] = float(style.ambient + (1 - style.ambient) * std::max(0.0, ns.dot(light)));
+      }
+    }
+  }
+
+  // outlines: darken the nearer side of every occlusion boundary (a neighbour within about one
+  // pixel is background or lies behind by more than the radius), so crossings read as such
+  if (style.outline_darken < 1) {
+    const int reach = S;
+    std::vector<std::uint8_t> edge(depth.size(), 0);
+    for (int py = 0; py < H; ++py)
+      for (int px = 0; px < W; ++px) {
+        const std::size_t idx = std::size_t(py) * std::size_t(W) + std::size_t(px);
+        if (!std::isfinite(depth[idx])) continue;
+        for (int d = 1; d <= reach && !edge[idx]; ++d) {
+          const int nx[4] = {px - d, px + d, px, px}, ny[4] = {py, py, py - d, py + d};
+          for (int q = 0; q < 4; ++q) {
+            if (nx[q] < 0 || ny[q] < 0 || nx[q] >= W || ny[q] >= H) continue;
+            if (depth[std::size_t(ny[q]) * std::size_t(W) + std::size_t(nx[q])] > depth[idx] + R) edge[idx] = 1;
+          }
+        }
+      }
+    for (std::size_t i = 0; i < edge.size(); ++i)
+      if (edge[i]) shade[i] *= float(style.outline_darken);
+  }
+
+  // shade and average S×S blocks
+  Image img(width, height, style.background);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      double acc[3] = {0, 0, 0};
+      for (int j = 0; j < S; ++j) {
+        for (int i = 0; i < S; ++i) {
+          const std::size_t idx = std::size_t(y * S + j) * std::size_t(W) + std::size_t(x * S + i);
+          Rgb col = style.background;
+          double s = 1;
+          if (std::isfinite(depth[idx])) {
+            col = on_stripe[idx] ? style.stripe : style.tube;
+            s = shade[idx];
+          }
+          acc[0] += s * col.r, acc[1] += s * col.g, acc[2] += s * col.b;
+        }
+      }
+      const double w = 1.0 / double(S * S);
+      img.set(x, y, {to_byte(w * acc[0]), to_byte(w * acc[1]), to_byte(w * acc[2])});
+    }
+  }
+  return img;
+}
+
+}  // namespace ibrod::render

@@ -1,0 +1,52 @@
+#pragma once
+// Pictures of the rod: a shaded tube of diameter D around the closed centreline X, with a stripe
+// on the side the director D¹ points to, so that twist shows as a helical stripe. Software
+// ray casting of one capsule (cylinder + spherical caps) per segment X_k → X_{k+1} (X_n = X_0)
+// under an orthographic camera, nearest hit per pixel (a z-buffer), Lambert + ambient shading,
+// dark outlines where one part of the tube passes in front of another, S×S supersampling. Knows points and directors only.
+#include <span>
+#include <string>
+#include <vector>
+
+#include "core/types.hpp"
+#include "render/image.hpp"
+
+namespace ibrod::render {
+
+/// An orthographic camera: it looks along `forward`; `up` (not parallel to forward) sets the
+/// image's upward direction. Image right = forward × up.
+struct View {
+  std::string name;
+  Vec3 forward{0, 0, -1};
+  Vec3 up{0, 1, 0};
+};
+
+/// The named views: "top" (down −z, x right, y up: the plane of the initial circle), "bottom",
+/// "side" (along +y: x right, z up), "front" (along −x: y right, z up) and "oblique" (from above,
+/// between x and −y). Unknown name: std::invalid_argument listing the names.
+View standard_view(const std::string& name);
+/// The names standard_view accepts, in a fixed order.
+std::vector<std::string> standard_view_names();
+
+struct Style {
+  Rgb background{255, 255, 255};
+  Rgb tube{60, 105, 200};     ///< body colour (blue: b > r)
+  Rgb stripe{240, 170, 30};   ///< stripe colour (orange: r > b)
+  double stripe_cos = 0.8;    ///< the stripe: unit normal · D¹ (⟂ to the axis) above this
+                              ///< (0.8: a band of ±37° about D¹, a fifth of the circumference)
+  double ambient = 0.3;       ///< shade = ambient + (1 − ambient) max(0, n · light)
+  double outline_darken = 0.45;  ///< shade factor of a ≈ 1 pixel outline on the near side of
+                                ///< occlusion boundaries (1: no outlines)
+  int supersample = 3;        ///< S×S rays per pixel, averaged
+  double margin = 0.04;       ///< free border on each side, fraction of the smaller image side
+};
+
+/// Renders the tube of diameter `diameter` (X's length unit) about the closed polygon X with the
+/// stripe along d1 (one director per point; interpolated along each segment and projected ⟂ to
+/// it), seen from `view`, into a width × height image. The scale fits the bounding sphere of the
+/// tube about the centroid of X into the image, so every view of one configuration has the same
+/// scale and centre. X.size() ≥ 2 and d1.size() = X.size(), else std::invalid_argument.
+Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diameter,
+                 const View& view, int width, int height, const Style& style = {});
+
+}  // namespace ibrod::render

@@ -1,0 +1,123 @@
+#!/usr/bin/python3
+"""End to end: two short runs of the real binary (ΔLk 2 at 0.1 M, ΔLk 3 at 0.05 M; 16³ grid,
+100 base pairs, 300 steps) analysed with `ibrod analyze`, one of them drawn with `ibrod render`,
+then python/ibrod_plot.py and python/ibrod_report.py on them.
+
+    /usr/bin/python3 tests/integration/test_plots.py /path/to/ibrod
+
+Registered in CTest (label integration) by tests/CMakeLists.txt. Exit status 0 when every check
+passes.
+"""
+import csv
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import unittest
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.image as mpimg  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+PLOT = os.path.join(ROOT, "python", "ibrod_plot.py")
+REPORT = os.path.join(ROOT, "python", "ibrod_report.py")
+PYTHON = "/usr/bin/python3"
+BINARY = None  # set from argv
+
+
+def sh(*args, check=True):
+    r = subprocess.run(list(args), stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    if check and r.returncode != 0:
+        raise AssertionError(f"{' '.join(args)} exited {r.returncode}:\n{r.stdout}")
+    return r
+
+
+class PlotsAndReport(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.mkdtemp(prefix="ibrod_plots_")
+        cls.runs = {}
+        for dlk, cs in ((2, 0.1), (3, 0.05)):
+            d = os.path.join(cls.tmp, f"lk{dlk}_cs{cs:g}")
+            sh(BINARY, "run", "-o", d, "--set", "grid.n=16", "--set", "grid.box_A=200",
+               "--set", "rod.base_pairs=100", "--set", f"rod.excess_link={dlk}",
+               "--set", f"solvent.salt_M={cs}", "--set", "time.t_end_us=0.03",
+               "--set", "output.every_steps=10", "--set", "output.frame_every_steps=20",
+               "--set", "run.fftw_measure=false",
+               "--set", "run.threads=1")
+            sh(BINARY, "analyze", "--quiet", d)
+            cls.runs[(dlk, cs)] = d
+        cls.a, cls.b = cls.runs[(2, 0.1)], cls.runs[(3, 0.05)]
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.tmp, ignore_errors=True)
+
+    def png(self, path):
+        self.assertTrue(os.path.isfile(path), path)
+        img = mpimg.imread(path)
+        self.assertEqual(img.ndim, 3)
+        return img
+
+    def test_1_analyze_and_render(self):
+        for d in self.runs.values():  # analysed in setUpClass
+            with open(os.path.join(d, "summary.json")) as f:
+                s = json.load(f)
+            for key in ("writhe_convergence_time_us", "relaxation_time_us", "transients",
+                        "closest_approach_A", "kinetic_power_law_exponent", "final_energies_kT"):
+                self.assertIn(key, s)
+            self.assertIn("stop_reason", s)  # the run's own keys survive
+        # only run a is rendered, so the report draws b with matplotlib 3-D
+        r = sh(BINARY, "render", self.a, "--views", "top,oblique", "--size", "240x180")
+        files = [l for l in r.stdout.splitlines() if l.endswith(".png")]
+        self.assertEqual(len(files), 2, r.stdout)
+        img = self.png(files[0])
+        self.assertEqual(img.shape[:2], (180, 240))
+        # --time picks the nearest frame of trajectory.h5 (frames every 0.002 µs)
+        r = sh(BINARY, "render", self.a, "--time", "0.0123", "--views", "side", "--size", "64x64")
+        self.assertIn("frame at t = 0.0120 us", r.stdout)
+        self.png(os.path.join(self.a, "render", "rod_side_t0.0120.png"))
+        self.assertEqual(sh(BINARY, "render", self.a, "--views", "diagonal", check=False).returncode, 2)
+        self.assertEqual(sh(BINARY, "analyze", os.path.join(self.tmp, "none"), check=False).returncode, 2)
+
+    def test_2_plot(self):
+        out = os.path.join(self.tmp, "plot.png")
+        sh(PYTHON, PLOT, self.a, self.b, "-o", out)
+        img = self.png(out)
+        self.assertGreater(img.shape[0], 500)  # three stacked panels
+        # not a run directory: a message and a non-zero status
+        r = sh(PYTHON, PLOT, self.tmp, "-o", os.path.join(self.tmp, "x.png"), check=False)
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("timeseries.csv", r.stdout)
+
+    def test_3_report(self):
+        rep = os.path.join(self.tmp, "report")
+        sh(PYTHON, REPORT, self.a, self.b, "-o", rep)
+        for name in ("shapes.png", "vs_excess_link.png", "timeseries_Cs0.05.png",
+                     "timeseries_Cs0.1.png"):
+            self.png(os.path.join(rep, name))
+        with open(os.path.join(rep, "report.md")) as f:
+            md = f.read()
+        self.assertIn("| ΔLk | Cs = 0.05 M | Cs = 0.1 M |", md)
+        self.assertIn("## Writhe convergence time", md)
+        self.assertIn("## Relaxation time", md)
+        self.assertNotIn("not analysed", md)
+        with open(os.path.join(rep, "runs.csv")) as f:
+            rows = list(csv.DictReader(f))
+        self.assertEqual(sorted(int(r["excess_link"]) for r in rows), [2, 3])
+        self.assertTrue(all(r["writhe_convergence_time_us"] != "" for r in rows))
+        # --ibrod renders the run that has no picture yet
+        self.assertFalse(os.path.isdir(os.path.join(self.b, "render")))
+        sh(PYTHON, REPORT, self.a, self.b, "-o", rep, "--ibrod", BINARY)
+        self.assertTrue(any(f.startswith("rod_oblique_t") for f in os.listdir(os.path.join(self.b, "render"))))
+
+
+if __name__ == "__main__":
+    if len(sys.argv) < 2:
+        sys.exit("usage: test_plots.py /path/to/ibrod")
+    BINARY = sys.argv.pop(1)
+    unittest.main(verbosity=2)

@@ -1,0 +1,169 @@
+// Rendering of a known circle: the PNG has the requested size and reads back unchanged; the
+// background shows where the rod is absent (the ring's centre, the corners) and the rod where it
+// is (on the ring); views differ; the stripe follows D¹; a twisted ribbon shows a stripe that
+// winds around the tube.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <numbers>
+#include <stdexcept>
+#include <vector>
+
+#include "render/image.hpp"
+#include "render/render.hpp"
+
+namespace ibrod::render {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+/// A circle of radius r0 about c in the z = 0 plane, n points, and a D¹ that turns `turns`
+/// times about the tangent, starting at angle phi0 from +z.
+struct Ring {
+  std::vector<Vec3> X, d1;
+  Ring(int n, double r0, int turns = 0, double phi0 = 0, Vec3 c = Vec3(10, -5, 3)) {
+    for (int k = 0; k < n; ++k) {
+      const double s = 2 * kPi * k / n;
+      const Vec3 radial(std::cos(s), std::sin(s), 0), z(0, 0, 1);
+      X.push_back(c + r0 * radial);
+      const double phi = phi0 + turns * s;
+      d1.push_back(std::cos(phi) * z + std::sin(phi) * radial);
+    }
+  }
+};
+
+bool is_background(Rgb p, Rgb bg = Style{}.background) { return p == bg; }
+bool is_tube(Rgb p) { return p.b > p.r + 20; }    // blue body, any shade
+bool is_stripe(Rgb p) { return p.r > p.b + 20; }  // orange stripe, any shade
+
+/// Pixel of the point x of the top view, for a ring centred like Ring's (the centroid is c).
+struct TopViewMap {
+  double scale;  // px per Å
+  int w, h;
+  TopViewMap(double r0, double D, int w_, int h_) : w(w_), h(h_) {
+    scale = 0.5 * std::min(w, h) * (1 - 2 * Style{}.margin) / (r0 + D / 2);
+  }
+  int px(double dx) const { return int(std::floor(0.5 * w + dx * scale)); }
+  int py(double dy) const { return int(std::floor(0.5 * h - dy * scale)); }
+};
+
+TEST(Png, WritesTheRequestedSizeAndReadsBackTheSamePixels) {
+  const Ring ring(200, 100.0);
+  const Image img = render_rod(ring.X, ring.d1, 20.0, standard_view("oblique"), 320, 240);
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("ibrod_render_png_" + std::to_string(::getpid()) + ".png");
+  write_png(path.string(), img);
+  const Image back = read_png(path.string());
+  std::filesystem::remove(path);
+  EXPECT_EQ(back.width, 320);
+  EXPECT_EQ(back.height, 240);
+  EXPECT_EQ(back.rgb, img.rgb);
+  EXPECT_THROW(read_png("/nonexistent/ibrod.png"), std::runtime_error);
+}
+
+TEST(Render, BackgroundInsideTheRingRodOnIt) {
+  const double r0 = 100, D = 20;
+  const Ring ring(300, r0);  // D¹ = +z: the stripe faces the top-view camera
+  const int w = 200, h = 200;
+  const Image img = render_rod(ring.X, ring.d1, D, standard_view("top"), w, h);
+  const TopViewMap m(r0, D, w, h);
+  EXPECT_TRUE(is_background(img.at(w / 2, h / 2)));  // the centre of the ring
+  EXPECT_TRUE(is_background(img.at(0, 0)));
+  EXPECT_TRUE(is_background(img.at(w - 1, h - 1)));
+  // a radius 0.8 r0 (inside the hole: the tube spans r0 ± 10 Å) and 1.15 r0 (outside)
+  EXPECT_TRUE(is_background(img.at(m.px(0.8 * r0), h / 2)));
+  EXPECT_TRUE(is_background(img.at(w / 2, m.py(1.15 * r0))));
+  // on the ring at eight angles: rod, and the centreline shows the stripe (D¹ = +z faces us)
+  for (int q = 0; q < 8; ++q) {
+    const double a = 2 * kPi * (q + 0.5) / 8;
+    const Rgb p = img.at(m.px(r0 * std::cos(a)), m.py(r0 * std::sin(a)));
+    EXPECT_FALSE(is_background(p)) << "angle " << a;
+    EXPECT_TRUE(is_stripe(p)) << "angle " << a << ": " << int(p.r) << "," << int(p.g) << "," << int(p.b);
+  }
+  // near the inner and outer rims the normal is ⟂ to D¹: tube colour
+  const Rgb rim = img.at(m.px(r0 + 0.8 * D / 2), h / 2);
+  EXPECT_TRUE(is_tube(rim)) << int(rim.r) << "," << int(rim.g) << "," << int(rim.b);
+}
+
+TEST(Render, StripeFollowsD1) {
+  const double r0 = 100, D = 20;
+  const int w = 200, h = 200;
+  const TopViewMap m(r0, D, w, h);
+  const Ring up(300, r0, 0, 0), down(300, r0, 0, kPi);  // D¹ = +z, −z
+  const Image a = render_rod(up.X, up.d1, D, standard_view("top"), w, h);
+  const Image b = render_rod(down.X, down.d1, D, standard_view("top"), w, h);
+  int stripe_a = 0, stripe_b = 0, tube_b = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      stripe_a += is_stripe(a.at(x, y));
+      stripe_b += is_stripe(b.at(x, y));
+      tube_b += is_tube(b.at(x, y));
+    }
+  EXPECT_GT(stripe_a, 500);  // a band along the whole ring
+  EXPECT_EQ(stripe_b, 0);    // the stripe is underneath, out of sight
+  EXPECT_GT(tube_b, 2000);
+  EXPECT_TRUE(is_tube(b.at(m.px(r0), h / 2)));
+}
+
+TEST(Render, ViewsDiffer) {
+  const double r0 = 100, D = 20;
+  const Ring ring(300, r0, 3);
+  const int w = 160, h = 160;
+  const Image top = render_rod(ring.X, ring.d1, D, standard_view("top"), w, h);
+  const Image side = render_rod(ring.X, ring.d1, D, standard_view("side"), w, h);
+  const Image obl = render_rod(ring.X, ring.d1, D, standard_view("oblique"), w, h);
+  auto differing = [&](const Image& p, const Image& q) {
+    int k = 0;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) k += !(p.at(x, y) == q.at(x, y));
+    return k;
+  };
+  EXPECT_GT(differing(top, side), w * h / 20);
+  EXPECT_GT(differing(top, obl), w * h / 20);
+  EXPECT_GT(differing(side, obl), w * h / 20);
+  // edge-on, the circle is a horizontal band through the middle: the centre is rod, the top
+  // row of the image is not
+  EXPECT_FALSE(is_background(side.at(w / 2, h / 2)));
+  EXPECT_TRUE(is_background(side.at(w / 2, h / 4)));
+  EXPECT_TRUE(is_background(top.at(w / 2, h / 2)));
+}
+
+TEST(Render, TwistWindsTheStripeAroundTheTube) {
+  // with ΔLk = 4 turns of D¹ the top view's centreline shows the stripe where D¹ faces +z:
+  // alternating stripe and tube along the ring, 4 stripe runs
+  const double r0 = 100, D = 20;
+  const Ring ring(600, r0, 4);
+  const int w = 240, h = 240;
+  const Image img = render_rod(ring.X, ring.d1, D, standard_view("top"), w, h);
+  const TopViewMap m(r0, D, w, h);
+  // count tube → stripe transitions; pixels at a stripe's edge (mixed colours) keep the state
+  int runs = 0;
+  bool prev = false;
+  const int samples = 720;
+  for (int q = 0; q <= samples; ++q) {
+    const double a = 2 * kPi * q / samples;
+    const Rgb p = img.at(m.px(r0 * std::cos(a)), m.py(r0 * std::sin(a)));
+    const bool clear_stripe = p.r > p.b + 60, clear_tube = p.b > p.r + 60;
+    if (clear_stripe && !prev) ++runs;
+    if (clear_stripe || clear_tube) prev = clear_stripe;
+  }
+  // 4 turns: 4 runs, the one through angle 0 counted at both ends at most
+  EXPECT_GE(runs, 4);
+  EXPECT_LE(runs, 5);
+}
+
+TEST(Render, BadInputThrows) {
+  const Ring ring(50, 10.0);
+  const std::vector<Vec3> short_d1(ring.d1.begin(), ring.d1.begin() + 10);
+  EXPECT_THROW(render_rod(ring.X, short_d1, 2.0, standard_view("top"), 10, 10), std::invalid_argument);
+  EXPECT_THROW(render_rod(ring.X, ring.d1, 2.0, standard_view("top"), 0, 10), std::invalid_argument);
+  EXPECT_THROW(standard_view("diagonal"), std::invalid_argument);
+  View v{"bad", {0, 0, 1}, {0, 0, 2}};
+  EXPECT_THROW(render_rod(ring.X, ring.d1, 2.0, v, 10, 10), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace ibrod::render
