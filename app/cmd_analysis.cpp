@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "exit_status.hpp"
 #include "io/analyze.hpp"
 #include "render/render.hpp"
 
@@ -19,15 +20,8 @@ namespace {
   int status = 0;
   try {
     work();
-  } catch (const ibrod::ConfigError& e) {
-    std::fprintf(stderr, "ibrod: error: %s\n", e.what());
-    status = 2;
-  } catch (const ibrod::RunError& e) {
-    std::fprintf(stderr, "ibrod: error: %s\n", e.what());
-    status = 3;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "ibrod: error: %s\n", e.what());
-    status = 1;
+    status = ibrod::app::report_error(e);
   }
   std::fflush(stdout);
   throw CLI::RuntimeError(status);

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "exit_status.hpp"
 #include "io/mpi_env.hpp"
 #include "io/sweep.hpp"
 
@@ -59,15 +60,9 @@ int sweep_main(const SweepArgs& a) {
                   "failed\n",
                   points, completed, skipped, failed);
     status = sig ? 128 + int(sig) : failed > 0 ? 4 : 0;
-  } catch (const ibrod::ConfigError& e) {
-    if (root) std::fprintf(stderr, "ibrod: error: %s\n", e.what());
-    status = 2;
-  } catch (const ibrod::RunError& e) {
-    std::fprintf(stderr, "ibrod: error: %s\n", e.what());
-    status = 3;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "ibrod: error: %s\n", e.what());
-    status = 1;
+    // a bad sweep file is the same on every rank: only rank 0 says so
+    status = ibrod::app::report_error(e, root || !dynamic_cast<const ibrod::ConfigError*>(&e));
   }
   std::fflush(stdout);
   return status;

@@ -18,6 +18,7 @@
 #include "core/error.hpp"
 #include "cmd_analysis.hpp"
 #include "cmd_sweep.hpp"
+#include "exit_status.hpp"
 #include "io/bench.hpp"
 #include "io/config.hpp"
 #include "io/run.hpp"
@@ -125,14 +126,7 @@ int main(int argc, char** argv) {
       return 128 + r.signal;
     }
     return 0;
-  } catch (const ibrod::ConfigError& e) {
-    std::fprintf(stderr, "ibrod: error: %s\n", e.what());
-    return 2;
-  } catch (const ibrod::RunError& e) {
-    std::fprintf(stderr, "ibrod: error: %s\n", e.what());
-    return 3;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "ibrod: error: %s\n", e.what());
-    return 1;
+    return ibrod::app::report_error(e);
   }
 }
