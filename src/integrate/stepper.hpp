@@ -2,8 +2,8 @@
 // One time step of the generalized IB method (MODEL §4), the only place that wires the fluid, the
 // IB coupling and the rod forces together:
 //   1. rod forces at Xⁿ, Dⁿ: elastic F, T (point force/torque), + electrostatic + steric F
-//   2. spread F, T to the fluid force density fⁿ (force + ½ curl of torque)
-//   3. fluid step uⁿ → uⁿ⁺¹
+//   2. FluidSolver::begin_step: r = ρuⁿ/Δt − ρS_h(uⁿ) written over the force array
+//   3. spread F, T into it (force + ½ curl of torque: r += fⁿ), FluidSolver::finish_step: uⁿ⁺¹
 //   4. interpolate U, W at Xⁿ from uⁿ⁺¹
 //   5. move: X += Δt U, D ← R(Δt W) D
 // Buffers are sized once; step() allocates nothing.
