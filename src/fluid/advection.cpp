@@ -66,53 +66,67 @@ IBROD_ROW_CLONES void advect_row(int n, const double* const* c, const double* co
     row(std::false_type{});
 }
 
+}  // namespace
+
+void rhs_plane(int n, double h, const int* next, const int* prev,
+               std::array<const double*, 3> uc, std::array<const double*, 3> uxp,
+               std::array<const double*, 3> uxm, std::array<double*, 3> r, double a, double b,
+               bool assign) {
+  const std::size_t nz = std::size_t(n);
+  // S_h carries 1/(4h): ½ from the skew average, ½h from each central difference.
+  const double b4 = b / (4.0 * h);
+  for (int j = 0; j < n; ++j) {
+    const std::size_t oc = std::size_t(j) * nz;
+    if (b == 0.0) {  // Stokes: memory-bound, plain SSE2 is as fast as it gets
+      const double *u0 = uc[0] + oc, *u1 = uc[1] + oc, *u2 = uc[2] + oc;
+      double *r0 = r[0] + oc, *r1 = r[1] + oc, *r2 = r[2] + oc;
+      if (assign) {
+#pragma omp simd
+        for (int k = 0; k < n; ++k) {
+          r0[k] = a * u0[k];
+          r1[k] = a * u1[k];
+          r2[k] = a * u2[k];
+        }
+      } else {
+#pragma omp simd
+        for (int k = 0; k < n; ++k) {
+          r0[k] += a * u0[k];
+          r1[k] += a * u1[k];
+          r2[k] += a * u2[k];
+        }
+      }
+      continue;
+    }
+    const std::size_t oyp = std::size_t(next[j]) * nz;
+    const std::size_t oym = std::size_t(prev[j]) * nz;
+    const double* c[3] = {uc[0] + oc, uc[1] + oc, uc[2] + oc};
+    const double* xp[3] = {uxp[0] + oc, uxp[1] + oc, uxp[2] + oc};
+    const double* xm[3] = {uxm[0] + oc, uxm[1] + oc, uxm[2] + oc};
+    const double* yp[3] = {uc[0] + oyp, uc[1] + oyp, uc[2] + oyp};
+    const double* ym[3] = {uc[0] + oym, uc[1] + oym, uc[2] + oym};
+    double* rr[3] = {r[0] + oc, r[1] + oc, r[2] + oc};
+    advect_row(n, c, xp, xm, yp, ym, rr, a, b4, assign);
+  }
+}
+
+namespace {
+
 void rhs_pass(const GridSpec& grid, const int* next, const int* prev,
               std::array<const double*, 3> u, std::array<double*, 3> r, double a, double b,
               int threads, bool assign) {
   const int n = grid.n;
-  const std::size_t nz = std::size_t(n);
-  // S_h carries 1/(4h): ½ from the skew average, ½h from each central difference.
-  const double b4 = b / (4.0 * grid.h());
-  const bool advect = b != 0.0;
-
+  const std::size_t plane = std::size_t(n) * n;
+  const double h = grid.h();
+  auto at = [plane](std::array<const double*, 3> v, int i) {
+    return std::array<const double*, 3>{v[0] + i * plane, v[1] + i * plane, v[2] + i * plane};
+  };
 #pragma omp parallel for num_threads(threads) schedule(static)
   for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < n; ++j) {
-      const std::size_t oc = (std::size_t(i) * n + j) * nz;
-      if (!advect) {  // Stokes: memory-bound, plain SSE2 is as fast as it gets
-        const double *u0 = u[0] + oc, *u1 = u[1] + oc, *u2 = u[2] + oc;
-        double *r0 = r[0] + oc, *r1 = r[1] + oc, *r2 = r[2] + oc;
-        if (assign) {
-#pragma omp simd
-          for (int k = 0; k < n; ++k) {
-            r0[k] = a * u0[k];
-            r1[k] = a * u1[k];
-            r2[k] = a * u2[k];
-          }
-        } else {
-#pragma omp simd
-          for (int k = 0; k < n; ++k) {
-            r0[k] += a * u0[k];
-            r1[k] += a * u1[k];
-            r2[k] += a * u2[k];
-          }
-        }
-        continue;
-      }
-      const std::size_t oxp = (std::size_t(next[i]) * n + j) * nz;
-      const std::size_t oxm = (std::size_t(prev[i]) * n + j) * nz;
-      const std::size_t oyp = (std::size_t(i) * n + next[j]) * nz;
-      const std::size_t oym = (std::size_t(i) * n + prev[j]) * nz;
-      const double* c[3] = {u[0] + oc, u[1] + oc, u[2] + oc};
-      const double* xp[3] = {u[0] + oxp, u[1] + oxp, u[2] + oxp};
-      const double* xm[3] = {u[0] + oxm, u[1] + oxm, u[2] + oxm};
-      const double* yp[3] = {u[0] + oyp, u[1] + oyp, u[2] + oyp};
-      const double* ym[3] = {u[0] + oym, u[1] + oym, u[2] + oym};
-      double* rr[3] = {r[0] + oc, r[1] + oc, r[2] + oc};
-      advect_row(n, c, xp, xm, yp, ym, rr, a, b4, assign);
-    }
+    std::array<double*, 3> ri{r[0] + i * plane, r[1] + i * plane, r[2] + i * plane};
+    rhs_plane(n, h, next, prev, at(u, i), at(u, next[i]), at(u, prev[i]), ri, a, b, assign);
   }
 }
+
 
 }  // namespace
 
