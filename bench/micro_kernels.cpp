@@ -98,6 +98,31 @@ void BM_Interpolate(benchmark::State& st) {
 }
 BENCHMARK(BM_Interpolate)->Arg(600)->Arg(6000)->Unit(benchmark::kMicrosecond)->UseRealTime();
 
+// the plane-by-plane coupling of the step (ib::PlaneCoupler): 0 = kernel weights and plane
+// lists, 1 = spreading into every x-plane, 2 = sampling every x-plane + the per-point sums.
+// Every plane is the same cache-resident buffer, as in the fluid's plane pass (where the plane
+// was just written); the work per plane is the real one.
+void BM_PlaneCoupling(benchmark::State& st) {
+  CouplingFixture fx(64, int(st.range(0)));
+  ib::PlaneCoupler pc(fx.cp, int(st.range(0)));
+  pc.prepare(fx.s.X, fx.F, fx.T);
+  const int n = fx.p.stepper.grid.n;
+  const std::size_t np = std::size_t(n) * n;
+  const auto g = fx.g();
+  const int what = int(st.range(1));
+  for (auto _ : st) {
+    if (what == 0) pc.prepare(fx.s.X, fx.F, fx.T);
+    for (int i = 0; what == 1 && i < n; ++i) pc.add_plane(i, {g[0], g[0] + np, g[0] + 2 * np});
+    for (int i = 0; what == 2 && i < n; ++i) pc.sample_plane(i, {g[0], g[0] + np, g[0] + 2 * np});
+    if (what == 2) pc.finish_interpolation(fx.U, fx.W);
+  }
+  st.SetItemsProcessed(st.iterations() * st.range(0));
+}
+BENCHMARK(BM_PlaneCoupling)
+    ->ArgsProduct({{600, 6000}, {0, 1, 2}})
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
+
 void BM_ElasticForces(benchmark::State& st) {
   const auto p = io::to_params(reference(64, int(st.range(0))));
   const auto s = ring(p);
@@ -138,22 +163,26 @@ struct FluidFixture {
   }
 };
 
-// the right-hand-side pass r = ρu/Δt − ρS_h(u) (FluidSolver::begin_step)
-void BM_AdvectionPass(benchmark::State& st) {
+// the three passes of FluidSolver::finish_step, alone: 0 = rhs + 2-D plane FFTs,
+// 1 = x FFTs + solve + inverse x FFTs, 2 = inverse 2-D plane FFTs; 3 = the same transforms
+// with nothing else (run_split_ffts_only)
+void BM_FluidPass(benchmark::State& st) {
   FluidFixture fx(int(st.range(0)));
-  for (auto _ : st) fx.fl.begin_step();
+  const int pass = int(st.range(1));
+  for (auto _ : st) {
+    if (pass == 0) fx.fl.pass_rhs_planes();
+    if (pass == 1) fx.fl.pass_pencils();
+    if (pass == 2) fx.fl.pass_inverse_planes();
+    if (pass == 3) fx.fl.run_split_ffts_only();
+  }
   st.SetItemsProcessed(st.iterations() * std::int64_t(fx.fl.grid().size()));
 }
-BENCHMARK(BM_AdvectionPass)->Arg(32)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_FluidPass)
+    ->ArgsProduct({{32, 64, 128}, {0, 1, 2, 3}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
-void BM_SpectralPass(benchmark::State& st) {
-  FluidFixture fx(int(st.range(0)));
-  for (auto _ : st) fx.fl.run_spectral_only();
-  st.SetItemsProcessed(st.iterations() * std::int64_t(fx.fl.grid().size()));
-}
-BENCHMARK(BM_SpectralPass)->Arg(32)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
-
-// forward + backward plans, 3 components each (the six real FFTs of one step)
+// FFTW's threaded 3-D forward + backward plans, 3 components each (the six real FFTs of one step)
 void BM_FftRoundTrip(benchmark::State& st) {
   FluidFixture fx(int(st.range(0)));
   for (auto _ : st) fx.fl.run_ffts_only();

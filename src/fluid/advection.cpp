@@ -1,5 +1,7 @@
 #include "fluid/advection.hpp"
 
+#include "core/target_clones.hpp"
+
 #include <cstddef>
 #include <type_traits>
 
@@ -10,19 +12,14 @@ namespace {
 // time: in SSE2 the advection pass costs ~1.15 ms at 64³, 27 % of the step's FFTs. An AVX2+FMA
 // clone, chosen once by the loader, takes ~0.74 ms (the Stokes pass, pure memory traffic, takes
 // 0.46 ms). FMA changes round-off only, like FFTW's own run-time choice of kernels and plans.
-// A -march=native build (IBROD_NATIVE) needs no clones.
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__AVX2__)
-#define IBROD_ROW_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
-#else
-#define IBROD_ROW_CLONES
-#endif
+// (IBROD_TARGET_CLONES, core/target_clones.hpp)
 
 // One z-row (n contiguous points) of r_c += a u_c − b S_h(u)_c, with b4 = b/(4h) (the 1/(4h) of
 // the flux form folded in). c: the centre rows of u; xp, xm, yp, ym: the rows of the x/y
 // neighbours; z neighbours are k ± 1 in the same row, wrapped only at the two row ends.
 // assign: r_c = a u_c − b S_h(u)_c instead of r_c += …; a run-time flag, because target_clones
 // does not combine with templates, but the two loops below are separate, so both vectorise.
-IBROD_ROW_CLONES void advect_row(int n, const double* const* c, const double* const* xp,
+IBROD_TARGET_CLONES void advect_row(int n, const double* const* c, const double* const* xp,
                                  const double* const* xm, const double* const* yp,
                                  const double* const* ym, double* const* r, double a, double b4,
                                  bool assign) {

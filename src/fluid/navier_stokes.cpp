@@ -15,6 +15,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/target_clones.hpp"
 #include "fluid/advection.hpp"
 #include "fluid/fftw_wisdom.hpp"
 
@@ -42,6 +43,13 @@ void save_wisdom_cache(const std::string& path) {
   if (ec || fs::exists(tmp, ec)) fs::remove(tmp, ec);
 }
 
+// Makes a set of plans with `make(flags)` (which returns false, having destroyed whatever it
+// made, if a plan fails). With FFTW_MEASURE, wisdom already in the process (a resumed run imports
+// its own first) wins; otherwise the on-disk cache, and only if that lacks these plans too,
+// FFTW_MEASURE, saved for next time.
+template <class Make>
+bool plan_with_wisdom(bool measure, unsigned flags, Make make);
+
 }  // namespace
 
 std::string wisdom_cache_path() {
@@ -52,6 +60,21 @@ std::string wisdom_cache_path() {
     return std::string(h) + "/.cache/ibrod/fftw-wisdom";
   return {};
 }
+
+namespace {
+template <class Make>
+bool plan_with_wisdom(bool measure, unsigned flags, Make make) {
+  if (!measure) return make(flags | FFTW_ESTIMATE);
+  flags |= FFTW_MEASURE;
+  if (make(flags | FFTW_WISDOM_ONLY)) return true;
+  const std::string cache = wisdom_cache_path();
+  if (!cache.empty()) import_wisdom(cache);
+  if (make(flags | FFTW_WISDOM_ONLY)) return true;
+  if (!make(flags)) return false;
+  if (!cache.empty()) save_wisdom_cache(cache);
+  return true;
+}
+}  // namespace
 
 FluidSolver::FluidSolver(const GridSpec& grid, const FluidParams& params, int threads,
                          bool plan_measure)
@@ -88,63 +111,83 @@ FluidSolver::FluidSolver(const GridSpec& grid, const FluidParams& params, int th
     }
   }
 
+  // the k_z symbols once per double of the interleaved half spectrum (solve_row)
+  grad_symbol2_.resize(2 * std::size_t(n / 2 + 1));
+  lap_symbol2_.resize(2 * std::size_t(n / 2 + 1));
+  for (int k = 0; k <= n / 2; ++k) {
+    grad_symbol2_[2 * k] = grad_symbol2_[2 * k + 1] = grad_symbol_[k];
+    lap_symbol2_[2 * k] = lap_symbol2_[2 * k + 1] = lap_symbol_[k];
+  }
+
   init_fftw_threads();
   const std::size_t nr = grid_.size();
-  const std::size_t nc = std::size_t(n) * n * (n / 2 + 1);
+  const int nzh = n / 2 + 1;
+  const std::size_t nc = std::size_t(n) * n * nzh;
+  const std::size_t np = std::size_t(n) * n;  // points of one real x-plane
+  plan_measure_ = plan_measure;
   double* u = fftw_alloc_real(3 * nr);
   double* f = fftw_alloc_real(3 * nr);
   fftw_complex* fh = fftw_alloc_complex(3 * nc);
+  plane_buf_ = fftw_alloc_real(3 * np * std::size_t(threads_));
   // Components are consecutive blocks of one allocation (howmany = 3 plans need a fixed
-  // stride); n even makes every block start 16-byte aligned, like the base.
+  // stride); n even makes every block start 32-byte aligned, like the base.
   for (int c = 0; c < 3; ++c) {
     u_[c] = u ? u + c * nr : nullptr;
     f_[c] = f ? f + c * nr : nullptr;
     fh_[c] = fh ? reinterpret_cast<std::complex<double>*>(fh + c * nc) : nullptr;
   }
-  if (!u || !f || !fh) {
+  if (!u || !f || !fh || !plane_buf_) {
     // u_[0] etc. point at the allocation bases, so release() frees exactly what was allocated
     release();
     throw std::bad_alloc();
   }
 
-  const int dims[3] = {n, n, n};
-  // FFTW_DESTROY_INPUT: step() owns both inputs as scratch (force is consumed, r̂ is rebuilt).
-  const unsigned flags = (plan_measure ? FFTW_MEASURE : FFTW_ESTIMATE) | FFTW_DESTROY_INPUT;
-  fftw_plan_with_nthreads(threads_);
+  // The step's transforms are single-threaded FFTW plans that the OpenMP passes execute on
+  // their own planes and slices (fftw_execute_dft_* on new arrays is thread-safe). A new array
+  // must have the alignment the plan was made for: x-planes start at multiples of n·n reals or
+  // n·(n/2+1) complex values (32-byte multiples for even n), y-slices at multiples of n/2+1
+  // complex values, which alternate between two alignments when n/2+1 is odd: one x plan each.
+  // FFTW_DESTROY_INPUT: the plane buffer and r̂ are scratch.
+  const int plane_dims[2] = {n, n};
+  fftw_iodim xdim{n, n * nzh, n * nzh};  // the x axis of the half spectrum
+  fftw_iodim many[2] = {{nzh, 1, 1}, {3, int(nc), int(nc)}};  // k_z, then the component
   auto make_plans = [&](unsigned fl) {
-    plan_forward_ =
-        fftw_plan_many_dft_r2c(3, dims, 3, f, nullptr, 1, int(nr), fh, nullptr, 1, int(nc), fl);
-    plan_backward_ =
-        fftw_plan_many_dft_c2r(3, dims, 3, fh, nullptr, 1, int(nc), u, nullptr, 1, int(nr), fl);
-    if (plan_forward_ && plan_backward_) return true;
+    fftw_plan_with_nthreads(1);
+    plan_plane_r2c_ = fftw_plan_many_dft_r2c(2, plane_dims, 3, plane_buf_, nullptr, 1, int(np),
+                                             fh, nullptr, 1, int(nc), fl);
+    plan_plane_c2r_ = fftw_plan_many_dft_c2r(2, plane_dims, 3, fh, nullptr, 1, int(nc), u,
+                                             nullptr, 1, int(nr), fl);
+    bool ok = plan_plane_r2c_ && plan_plane_c2r_;
+    for (int par = 0; par < 2; ++par) {
+      fftw_complex* slice = fh + par * nzh;
+      plan_x_fwd_[par] = fftw_plan_guru_dft(1, &xdim, 2, many, slice, slice, FFTW_FORWARD, fl);
+      plan_x_bwd_[par] = fftw_plan_guru_dft(1, &xdim, 2, many, slice, slice, FFTW_BACKWARD, fl);
+      ok = ok && plan_x_fwd_[par] && plan_x_bwd_[par];
+    }
+    if (ok) return true;
     release_plans();
     return false;
   };
-  if (!plan_measure) {
-    make_plans(flags);
-  } else if (!make_plans(flags | FFTW_WISDOM_ONLY)) {
-    // Wisdom already in the process (a resumed run imports its own first) wins; otherwise the
-    // on-disk cache, and only if that lacks these plans too, FFTW_MEASURE, saved for next time.
-    const std::string cache = wisdom_cache_path();
-    if (!cache.empty()) import_wisdom(cache);
-    if (!make_plans(flags | FFTW_WISDOM_ONLY) && make_plans(flags) && !cache.empty())
-      save_wisdom_cache(cache);
-  }
-  if (!plan_forward_ || !plan_backward_) {
+  plan_with_wisdom(plan_measure, FFTW_DESTROY_INPUT, make_plans);
+  if (!plan_plane_r2c_) {
     release();
     throw std::runtime_error("FluidSolver: FFTW planning failed");
   }
   // FFTW_MEASURE scribbles on the buffers while planning: start from rest only afterwards.
   std::fill(u, u + 3 * nr, 0.0);
   std::fill(f, f + 3 * nr, 0.0);
+  force_zero_ = true;
 }
 
 FluidSolver::~FluidSolver() { release(); }
 
 void FluidSolver::release_plans() {
-  if (plan_forward_) fftw_destroy_plan(as_plan(plan_forward_));
-  if (plan_backward_) fftw_destroy_plan(as_plan(plan_backward_));
-  plan_forward_ = plan_backward_ = nullptr;
+  for (void** p : {&plan_plane_r2c_, &plan_plane_c2r_, &plan_x_fwd_[0], &plan_x_fwd_[1],
+                   &plan_x_bwd_[0], &plan_x_bwd_[1], &plan_forward_, &plan_backward_,
+                   &plan_split_r2c_}) {
+    if (*p) fftw_destroy_plan(as_plan(*p));
+    *p = nullptr;
+  }
 }
 
 void FluidSolver::release() {
@@ -152,9 +195,11 @@ void FluidSolver::release() {
   fftw_free(u_[0]);  // fftw_free(nullptr) is a no-op
   fftw_free(f_[0]);
   fftw_free(fh_[0]);
+  fftw_free(plane_buf_);
   u_ = {};
   f_ = {};
   fh_ = {};
+  plane_buf_ = nullptr;
 }
 
 void FluidSolver::zero_force() {
@@ -162,85 +207,210 @@ void FluidSolver::zero_force() {
   double* f = f_[0];
 #pragma omp parallel for simd num_threads(threads_) schedule(static)
   for (std::ptrdiff_t i = 0; i < total; ++i) f[i] = 0.0;
-}
-
-void FluidSolver::step() {
-  // 1. r = ρuⁿ/Δt − ρS_h(uⁿ) + fⁿ, in place over the force (MODEL §4)
-  detail::accumulate_rhs(grid_, next_.data(), prev_.data(), {u_[0], u_[1], u_[2]}, f_,
-                         params_.density / params_.dt, params_.advection ? params_.density : 0.0,
-                         threads_);
-  finish_step();
+  force_zero_ = true;
 }
 
 void FluidSolver::begin_step() {
-  // r = ρuⁿ/Δt − ρS_h(uⁿ) over the force array; the caller adds fⁿ (MODEL §4)
-  detail::assign_rhs(grid_, next_.data(), prev_.data(), {u_[0], u_[1], u_[2]}, f_,
-                     params_.density / params_.dt, params_.advection ? params_.density : 0.0,
-                     threads_);
+  if (!force_zero_) zero_force();
+}
+
+void FluidSolver::step() { finish_step(); }
+
+void FluidSolver::step(const PlaneForcing& forcing) {
+  pass_rhs_planes(&forcing);
+  pass_pencils();
+  pass_inverse_planes();
+}
+
+void FluidSolver::step(const PlaneForcing& forcing, const PlaneSampler& sampler) {
+  pass_rhs_planes(&forcing);
+  pass_pencils();
+  pass_inverse_planes(&sampler);
 }
 
 void FluidSolver::finish_step() {
-  // 2. r̂ for all three components in one plan
-  fftw_execute(as_plan(plan_forward_));
-  // 3. projection, implicit viscosity and the 1/n³ of the FFT round trip, one pass
-  spectral_pass();
-  // 4. uⁿ⁺¹ back in real space
-  fftw_execute(as_plan(plan_backward_));
+  pass_rhs_planes();
+  pass_pencils();
+  pass_inverse_planes();
 }
 
-void FluidSolver::spectral_pass() {
+void FluidSolver::pass_rhs_planes(const PlaneForcing* forcing) {
+  const int n = grid_.n;
+  const std::size_t np = std::size_t(n) * n;
+  const std::size_t npc = std::size_t(n) * (n / 2 + 1);  // complex values of one x-plane
+  const double h = grid_.h();
+  const double a = params_.density / params_.dt;             // ρ/Δt
+  const double b = params_.advection ? params_.density : 0.0;  // ρ, or 0 for Stokes
+  const int* next = next_.data();
+  const int* prev = prev_.data();
+  fftw_plan plan = as_plan(plan_plane_r2c_);
+  auto at = [np](const std::array<double*, 3>& v, int i) {
+    return std::array<const double*, 3>{v[0] + i * np, v[1] + i * np, v[2] + i * np};
+  };
+#pragma omp parallel for num_threads(threads_) schedule(static)
+  for (int i = 0; i < n; ++i) {
+    double* buf = plane_buf_ + 3 * np * std::size_t(omp_get_thread_num());
+    const std::array<double*, 3> r{buf, buf + np, buf + 2 * np};
+    // r = ρuⁿ/Δt − ρS_h(uⁿ) + fⁿ (MODEL §4): fⁿ from the force array if it was written (the
+    // plane zeroed behind), plus the forcing's
+    const bool with_array = !force_zero_;
+    if (with_array) {
+      for (int c = 0; c < 3; ++c) {
+        double* f = f_[c] + i * np;
+        std::copy_n(f, np, r[c]);
+        std::fill_n(f, np, 0.0);
+      }
+    }
+    detail::rhs_plane(n, h, next, prev, at(u_, i), at(u_, next[i]), at(u_, prev[i]), r, a, b,
+                      !with_array);
+    if (forcing) forcing->add_plane(i, r);
+    // r̂ of this plane in y and z, into its place in the half spectrum
+    fftw_execute_dft_r2c(plan, buf, reinterpret_cast<fftw_complex*>(fh_[0]) + i * npc);
+  }
+  force_zero_ = true;
+}
+
+void FluidSolver::pass_pencils() {
+  const int n = grid_.n;
+  const int nzh = n / 2 + 1;
+  fftw_complex* base = reinterpret_cast<fftw_complex*>(fh_[0]);
+#pragma omp parallel for num_threads(threads_) schedule(static)
+  for (int j = 0; j < n; ++j) {
+    // the slice of wavenumber index j in y: x × k_z × 3 components, ~100 KB at 64³
+    const int par = (j * nzh) % 2;
+    fftw_complex* slice = base + std::size_t(j) * nzh;
+    fftw_execute_dft(as_plan(plan_x_fwd_[par]), slice, slice);
+    solve_slice(j);
+    fftw_execute_dft(as_plan(plan_x_bwd_[par]), slice, slice);
+  }
+}
+
+void FluidSolver::pass_inverse_planes(const PlaneSampler* sampler) {
+  const int n = grid_.n;
+  const std::size_t np = std::size_t(n) * n;
+  const std::size_t npc = std::size_t(n) * (n / 2 + 1);
+  fftw_plan plan = as_plan(plan_plane_c2r_);
+  fftw_complex* in = reinterpret_cast<fftw_complex*>(fh_[0]);
+#pragma omp parallel for num_threads(threads_) schedule(static)
+  for (int i = 0; i < n; ++i) {
+    fftw_execute_dft_c2r(plan, in + i * npc, u_[0] + i * np);
+    if (sampler) sampler->sample_plane(i, {u_[0] + i * np, u_[1] + i * np, u_[2] + i * np});
+  }
+}
+
+void FluidSolver::run_split_ffts_only() {
+  const int n = grid_.n;
+  const int nzh = n / 2 + 1;
+  const std::size_t np = std::size_t(n) * n;
+  const std::size_t npc = std::size_t(n) * nzh;
+  fftw_complex* fh = reinterpret_cast<fftw_complex*>(fh_[0]);
+  if (!plan_split_r2c_) {
+    // the step's plane r2c reads its three components n² apart (the plane buffer); here they
+    // are n³ apart (the force array): the same transform with another input stride
+    const int dims[2] = {n, n};
+    auto make = [&](unsigned fl) {
+      fftw_plan_with_nthreads(1);
+      plan_split_r2c_ = fftw_plan_many_dft_r2c(2, dims, 3, f_[0], nullptr, 1, int(grid_.size()),
+                                               fh, nullptr, 1, int(n * npc), fl);
+      return plan_split_r2c_ != nullptr;
+    };
+    if (!plan_with_wisdom(plan_measure_, FFTW_DESTROY_INPUT, make))
+      throw std::runtime_error("FluidSolver: FFTW planning failed");
+  }
+  force_zero_ = false;
+  // f's planes are aligned like the force array (n·n reals apart, n even)
+#pragma omp parallel for num_threads(threads_) schedule(static)
+  for (int i = 0; i < n; ++i)
+    fftw_execute_dft_r2c(as_plan(plan_split_r2c_), f_[0] + i * np, fh + i * npc);
+#pragma omp parallel for num_threads(threads_) schedule(static)
+  for (int j = 0; j < n; ++j) {
+    const int par = (j * nzh) % 2;
+    fftw_complex* slice = fh + std::size_t(j) * nzh;
+    fftw_execute_dft(as_plan(plan_x_fwd_[par]), slice, slice);
+    fftw_execute_dft(as_plan(plan_x_bwd_[par]), slice, slice);
+  }
+  pass_inverse_planes();
+}
+
+namespace {
+
+// One x-row (fixed wavenumbers k_x, k_y) of the per-wavenumber solve, MODEL §4:
+//   ûⁿ⁺¹ = P(k) r̂ / (ρ/Δt − μL̂(k)) / n³ = (r̂ − ĝ (ĝ·r̂)/|ĝ|²) · norm / (ρ/Δt) / den',
+//   den' = 1 + (μ Δt/ρ)(−L̂) ≥ 1, dimensionless.
+// The row is walked as 2(n/2+1) doubles (re, im interleaved) with the k_z symbols duplicated per
+// double (gz2, lz2), so the loop is contiguous and vectorises fully. One division per double:
+// q = 1/((|ĝ|² + ε) den') gives 1/|ĝ|² = den' q and 1/den' = (|ĝ|² + ε) q. Where ĝ = 0 (k_j ∈
+// {0, n/2} for all j) D_h and G_h vanish: no pressure, P = I; then ĝ·r̂ = 0 exactly and any finite
+// 1/|ĝ|² will do: ε = DBL_MIN keeps q finite (den' ≥ 1) without a branch, and leaves every nonzero
+// |ĝ|² (≥ sin²(2π/n)/h², Å⁻²) bit-for-bit unchanged.
+IBROD_TARGET_CLONES void solve_row(int len, double gx, double gy, double gxy2, double lxy,
+                                   const double* gz2, const double* lz2, double visc_per_inertia,
+                                   double out_scale, double* r0, double* r1, double* r2) {
+#pragma omp simd
+  for (int t = 0; t < len; ++t) {
+    const double gz = gz2[t];
+    const double g2 = gxy2 + gz * gz + DBL_MIN;                     // |ĝ|² + ε, Å⁻²
+    const double den = 1.0 + visc_per_inertia * (lxy + lz2[t]);     // den'
+    const double q = 1.0 / (g2 * den);
+    const double ig2 = den * q;                    // 1/|ĝ|²
+    const double scale = out_scale * (g2 * q);     // norm/(ρ/Δt)/den'
+    const double a0 = r0[t], a1 = r1[t], a2 = r2[t];
+    const double p = (gx * a0 + gy * a1 + gz * a2) * ig2;  // ĝ·r̂ / |ĝ|²
+    r0[t] = scale * (a0 - gx * p);
+    r1[t] = scale * (a1 - gy * p);
+    r2[t] = scale * (a2 - gz * p);
+  }
+}
+
+}  // namespace
+
+void FluidSolver::solve_slice(int j) {
   const int n = grid_.n;
   const double inertia = params_.density / params_.dt;  // ρ/Δt, g Å⁻³ s⁻¹
-  const double mu = params_.viscosity;
-
-  // ûⁿ⁺¹ = P(k) r̂ / (ρ/Δt − μL̂(k)) / n³: the unnormalised FFTW round trip multiplies by n³.
+  const double visc_per_inertia = params_.viscosity / inertia;  // μΔt/ρ, Å²
+  // the unnormalised FFTW round trip multiplies by n³
+  const double out_scale = 1.0 / double(grid_.size()) / inertia;
   const int nzh = n / 2 + 1;
-  const double norm = 1.0 / double(grid_.size());
   const double* gs = grad_symbol_.data();
   const double* ls = lap_symbol_.data();
   double* r0 = reinterpret_cast<double*>(fh_[0]);  // interleaved (re, im)
   double* r1 = reinterpret_cast<double*>(fh_[1]);
   double* r2 = reinterpret_cast<double*>(fh_[2]);
-#pragma omp parallel for num_threads(threads_) schedule(static)
+  const double gy = gs[j];
   for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < n; ++j) {
-      const double gx = gs[i], gy = gs[j];
-      const double gxy2 = gx * gx + gy * gy;
-      const double lxy = ls[i] + ls[j];
-      const std::size_t o = 2 * (std::size_t(i) * n + j) * nzh;
-#pragma omp simd
-      for (int k = 0; k < nzh; ++k) {
-        const double gz = gs[k];
-        const double g2 = gxy2 + gz * gz;
-        // Where ĝ = 0 (k_j ∈ {0, n/2} for all j) D_h and G_h vanish: no pressure, P = I. Then
-        // ĝ·r̂ = 0 exactly and any finite 1/|ĝ|² will do. Adding DBL_MIN instead of branching
-        // keeps the loop vectorised (a branch or max() does not) and leaves every nonzero |ĝ|²
-        // (≥ sin²(2π/n)/h², Å⁻²) bit-for-bit unchanged.
-        const double ig2 = 1.0 / (g2 + DBL_MIN);
-        const double scale = norm / (inertia + mu * (lxy + ls[k]));
-        const std::size_t q = o + 2 * std::size_t(k);
-        const double a0 = r0[q], b0 = r0[q + 1];
-        const double a1 = r1[q], b1 = r1[q + 1];
-        const double a2 = r2[q], b2 = r2[q + 1];
-        const double pa = (gx * a0 + gy * a1 + gz * a2) * ig2;  // ĝ·r̂ / |ĝ|²
-        const double pb = (gx * b0 + gy * b1 + gz * b2) * ig2;
-        r0[q] = scale * (a0 - gx * pa);
-        r0[q + 1] = scale * (b0 - gx * pb);
-        r1[q] = scale * (a1 - gy * pa);
-        r1[q + 1] = scale * (b1 - gy * pb);
-        r2[q] = scale * (a2 - gz * pa);
-        r2[q + 1] = scale * (b2 - gz * pb);
-      }
-    }
+    const double gx = gs[i];
+    const std::size_t o = 2 * (std::size_t(i) * n + j) * nzh;
+    solve_row(2 * nzh, gx, gy, gx * gx + gy * gy, ls[i] + ls[j], grad_symbol2_.data(),
+              lap_symbol2_.data(), visc_per_inertia, out_scale, r0 + o, r1 + o, r2 + o);
   }
 }
 
-void FluidSolver::run_spectral_only() { spectral_pass(); }
-
-void FluidSolver::run_forward_fft_only() { fftw_execute(as_plan(plan_forward_)); }
-void FluidSolver::run_backward_fft_only() { fftw_execute(as_plan(plan_backward_)); }
-
 void FluidSolver::run_ffts_only() {
+  if (!plan_forward_) {
+    // planned on first use, threaded like a textbook solver's, with the step's planner flags
+    const int n = grid_.n;
+    const int nr = int(grid_.size());
+    const int nc = n * n * (n / 2 + 1);
+    const int dims[3] = {n, n, n};
+    auto* fh = reinterpret_cast<fftw_complex*>(fh_[0]);
+    auto make = [&](unsigned fl) {
+      fftw_plan_with_nthreads(threads_);
+      plan_forward_ =
+          fftw_plan_many_dft_r2c(3, dims, 3, f_[0], nullptr, 1, nr, fh, nullptr, 1, nc, fl);
+      plan_backward_ =
+          fftw_plan_many_dft_c2r(3, dims, 3, fh, nullptr, 1, nc, u_[0], nullptr, 1, nr, fl);
+      fftw_plan_with_nthreads(1);
+      if (plan_forward_ && plan_backward_) return true;
+      for (void** p : {&plan_forward_, &plan_backward_}) {
+        if (*p) fftw_destroy_plan(as_plan(*p));
+        *p = nullptr;
+      }
+      return false;
+    };
+    if (!plan_with_wisdom(plan_measure_, FFTW_DESTROY_INPUT, make))
+      throw std::runtime_error("FluidSolver: FFTW planning failed");
+  }
+  force_zero_ = false;
   fftw_execute(as_plan(plan_forward_));
   fftw_execute(as_plan(plan_backward_));
 }

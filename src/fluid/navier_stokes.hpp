@@ -23,6 +23,30 @@ struct FluidParams {
   bool advection = true;     ///< include ρS_h(u); false gives the unsteady Stokes equations
 };
 
+/// A body force supplied one x-plane at a time (FluidSolver::step(const PlaneForcing&)), e.g. an
+/// immersed boundary's spreading: add_plane(i, plane) adds (+=) the force density (g Å⁻² s⁻²) of
+/// x-plane i to three arrays (components) of n·n values, layout j·n + k. It is called once per
+/// plane per step, concurrently for different planes.
+class PlaneForcing {
+ public:
+  virtual void add_plane(int i, std::array<double*, 3> plane) const = 0;
+
+ protected:
+  ~PlaneForcing() = default;
+};
+
+/// Reads the new velocity one x-plane at a time (FluidSolver::step(forcing, sampler)), e.g. an
+/// immersed boundary's interpolation: sample_plane(i, plane) is called once per plane per step,
+/// as soon as the plane of uⁿ⁺¹ (three arrays of n·n values, layout j·n + k, Å s⁻¹) is final,
+/// concurrently for different planes.
+class PlaneSampler {
+ public:
+  virtual void sample_plane(int i, std::array<const double*, 3> plane) const = 0;
+
+ protected:
+  ~PlaneSampler() = default;
+};
+
 class FluidSolver {
  public:
   /// threads: FFTW/OpenMP threads (0 = OpenMP default). plan_measure: FFTW_MEASURE (true) or
@@ -48,52 +72,79 @@ class FluidSolver {
   std::array<const double*, 3> velocity() const { return {u_[0], u_[1], u_[2]}; }
 
   /// body-force density component c, g Å⁻² s⁻² (force per volume). Callers accumulate (+=) into
-  /// it after zero_force(); step() consumes it (its contents are unspecified afterwards).
-  double* force(int c) { return f_[c]; }
-  std::array<double*, 3> force() { return {f_[0], f_[1], f_[2]}; }
+  /// it after zero_force() (or begin_step()); step() and finish_step() consume it and leave it
+  /// zero. The non-const accessors mark it as written.
+  double* force(int c) { force_zero_ = false; return f_[c]; }
+  std::array<double*, 3> force() { force_zero_ = false; return {f_[0], f_[1], f_[2]}; }
   void zero_force();
 
   /// Advance u by one step Δt with the current force density (MODEL §4). No allocation.
   void step();
+  /// The same with the force density of `forcing` added (to force(), if that was written), plane
+  /// by plane while the right-hand side is assembled: the fast path, no grid-sized force pass.
+  void step(const PlaneForcing& forcing);
+  /// ... and with `sampler` reading each plane of uⁿ⁺¹ while it is in cache.
+  void step(const PlaneForcing& forcing, const PlaneSampler& sampler);
 
   /// The same step in two halves, for a caller that spreads its forces in between:
   ///   begin_step();  (accumulate (+=) the force density into force());  finish_step();
-  /// begin_step() overwrites force() with ρuⁿ/Δt − ρS_h(uⁿ) (no zero_force() needed, and the
-  /// force array is read once less than by step()); finish_step() does the FFTs and the solve and
-  /// leaves uⁿ⁺¹ in velocity(). Equal to zero_force(); spread; step() up to round-off (fⁿ is
-  /// added to the other terms of r in another order). No allocation.
+  /// begin_step() makes sure force() is zero (it normally already is: finish_step() zeroes the
+  /// force array as it consumes it, so no separate zeroing pass runs). finish_step() = step().
   void begin_step();
   void finish_step();
+
+  /// finish_step() is three OpenMP passes over the grid, public for the benchmark (each alone is
+  /// not a meaningful operation; called in order they are the step):
+  ///  1. x-planes: r = ρuⁿ/Δt − ρS_h(uⁿ) + fⁿ into a per-thread plane buffer (fⁿ from force(),
+  ///     zeroed behind, if it was written, and from `forcing` if given), and the 2-D (y, z)
+  ///     real-to-complex FFTs of the plane;
+  ///  2. y-slices of the half spectrum: the 1-D x FFTs, the per-wavenumber solve, the inverse
+  ///     x FFTs, all while the slice is in cache;
+  ///  3. x-planes: the 2-D complex-to-real inverse FFTs into velocity().
+  void pass_rhs_planes(const PlaneForcing* forcing = nullptr);
+  void pass_pencils();
+  void pass_inverse_planes(const PlaneSampler* sampler = nullptr);
 
   /// Fluid kinetic energy ½ρ Σ|u|² h³, g Å² s⁻².
   double kinetic_energy() const;
   /// max over the grid of |D_h·u| (central-difference divergence), s⁻¹.
   double max_divergence() const;
 
-  /// Benchmark aid: executes the forward and the backward plan once on the solver's own buffers
-  /// (the 6 real FFTs of one step), clobbering force and velocity. Not part of the physics.
+  /// Benchmark aid: FFTW's own threaded 3-D transforms of the same size (three r2c and three c2r
+  /// 64³ transforms at 64³, planned with the solver's flags on its own buffers: the "six FFTs of
+  /// one step" a textbook code would run), planned on first use. Clobbers force and velocity;
+  /// not part of the physics.
   void run_ffts_only();
-  void run_forward_fft_only();   ///< the forward plan alone (benchmark aid, clobbers force)
-  void run_backward_fft_only();  ///< the backward plan alone (benchmark aid, clobbers velocity)
-  /// Benchmark aid: the spectral pass of finish_step() alone, on whatever the spectral buffer
-  /// holds. Not part of the physics.
-  void run_spectral_only();
+  /// Benchmark aid: the same six transforms as the step does them (2-D plane FFTs, 1-D x FFTs
+  /// per y-slice, inverse 2-D plane FFTs, threaded over planes and slices) with nothing else:
+  /// the step's own FFT time. Clobbers force and velocity; not part of the physics.
+  void run_split_ffts_only();
 
  private:
   GridSpec grid_;
   FluidParams params_;
   std::array<double*, 3> u_{};                 // velocity, real space
   std::array<double*, 3> f_{};                 // force density, then right-hand side r
-  std::array<std::complex<double>*, 3> fh_{};  // r̂, then ûⁿ⁺¹
-  void* plan_forward_ = nullptr;               // fftw_plan r → r̂ (3 components)
-  void* plan_backward_ = nullptr;              // fftw_plan ûⁿ⁺¹ → u (3 components)
+  std::array<std::complex<double>*, 3> fh_{};  // r̂, then ûⁿ⁺¹, layout [x][y][k_z]
+  double* plane_buf_ = nullptr;                // per thread: 3 real n×n planes of r
+  bool force_zero_ = true;                     // f_ known to be all zero
+  bool plan_measure_ = true;
+  void* plan_plane_r2c_ = nullptr;   // 3 × 2-D (y, z) r2c: plane buffer → r̂ plane
+  void* plan_plane_c2r_ = nullptr;   // 3 × 2-D (y, z) c2r: û plane → u plane
+  void* plan_x_fwd_[2] = {};         // 1-D x FFTs of one y-slice (k_z × 3 components), for the
+  void* plan_x_bwd_[2] = {};         //   two alignments of a slice start (even, odd y)
+  void* plan_forward_ = nullptr;     // benchmark only: threaded 3-D r2c, 3 components
+  void* plan_backward_ = nullptr;    // benchmark only: threaded 3-D c2r, 3 components
+  void* plan_split_r2c_ = nullptr;   // benchmark only: plan_plane_r2c_ reading the force array
   int threads_ = 1;
   std::vector<int> next_, prev_;     // periodic neighbour index i ± 1 (mod n), made once
   std::vector<double> grad_symbol_;  // sin(2πk/n)/h, Å⁻¹, k = 0..n−1; exactly 0 at k = 0, n/2
   std::vector<double> lap_symbol_;   // (4/h²) sin²(πk/n), Å⁻², k = 0..n−1 (= −L̂ per direction)
+  std::vector<double> grad_symbol2_, lap_symbol2_;  // k = 0..n/2, each twice (re, im)
   void release();                    // frees plans and buffers (destructor, failed constructor)
   void release_plans();
-  void spectral_pass();              // r̂ → ûⁿ⁺¹ in place: projection, viscosity, 1/n³
+  void solve_slice(int j);           // r̂ → ûⁿ⁺¹ in place on the y-slice j: projection,
+                                     // implicit viscosity, 1/n³
 };
 
 /// On-disk FFTW wisdom cache used by FluidSolver when plan_measure is set: $IBROD_FFTW_WISDOM_CACHE

@@ -3,6 +3,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
 
 namespace ibrod::integrate {
 
@@ -18,6 +19,7 @@ Stepper::Stepper(const StepperParams& p)
     : p_((set_threads(p.threads), p)),
       fluid_(std::make_unique<fluid::FluidSolver>(p.grid, p.fluid, p.threads, p.plan_measure)),
       coupler_(p.grid, p.kernel_width),
+      plane_coupler_(coupler_, p.rod.n),
       electro_(p.electro, p.rod.n),
       steric_(p.steric, p.rod.n) {
   const int n = p.rod.n;
@@ -41,13 +43,12 @@ StepEnergies Stepper::compute_forces(const rod::RodState& s) {
 
 void Stepper::step(rod::RodState& s) {
   last_ = compute_forces(s);
-  // r = ρuⁿ/Δt − ρS_h(uⁿ) overwrites the force array, fⁿ is spread onto it, then the solve:
-  // MODEL §4's r without a zeroing pass (FluidSolver::begin_step)
-  fluid_->begin_step();
-  coupler_.spread(s.X, F_, T_, fluid_->force());
-  fluid_->finish_step();
-  const fluid::FluidSolver& fl = *fluid_;
-  coupler_.interpolate(s.X, fl.velocity(), U_, W_);
+  // fⁿ = spread(F, T) is added to r = ρuⁿ/Δt − ρS_h(uⁿ) plane by plane inside the fluid step
+  // (MODEL §4), and U, W at Xⁿ are sampled from uⁿ⁺¹ plane by plane: the kernel weights are
+  // evaluated once, and no grid-sized pass is spent on either
+  plane_coupler_.prepare(s.X, F_, T_);
+  fluid_->step(PlaneCouplerForcing(plane_coupler_), PlaneCouplerSampler(plane_coupler_));
+  plane_coupler_.finish_interpolation(U_, W_);
   rod::advance(s, U_, W_, p_.fluid.dt);
 }
 

@@ -2,11 +2,14 @@
 // One time step of the generalized IB method (MODEL §4), the only place that wires the fluid, the
 // IB coupling and the rod forces together:
 //   1. rod forces at Xⁿ, Dⁿ: elastic F, T (point force/torque), + electrostatic + steric F
-//   2. FluidSolver::begin_step: r = ρuⁿ/Δt − ρS_h(uⁿ) written over the force array
-//   3. spread F, T into it (force + ½ curl of torque: r += fⁿ), FluidSolver::finish_step: uⁿ⁺¹
-//   4. interpolate U, W at Xⁿ from uⁿ⁺¹
+//   2. PlaneCoupler::prepare: kernel weights of every point, points listed by x-plane
+//   3. FluidSolver::step(forcing, sampler): per x-plane r = ρuⁿ/Δt − ρS_h(uⁿ) + fⁿ, fⁿ = spread
+//      F, T (force + ½ curl of torque) added to the plane in cache; FFTs and the solve give
+//      uⁿ⁺¹, and each x-plane of it is sampled for the interpolation as soon as it is made
+//   4. interpolate U, W at Xⁿ from uⁿ⁺¹: the planes' shares added in a fixed order
 //   5. move: X += Δt U, D ← R(Δt W) D
 // Buffers are sized once; step() allocates nothing.
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -37,6 +40,24 @@ struct StepEnergies {
   double steric = 0;
 };
 
+/// The IB coupling as the fluid's plane-by-plane forcing and sampler (src/fluid knows nothing of
+/// rods): spreading into each x-plane of the right-hand side, interpolation from each x-plane of
+/// the new velocity.
+struct PlaneCouplerForcing final : fluid::PlaneForcing {
+  const ib::PlaneCoupler& coupler;
+  explicit PlaneCouplerForcing(const ib::PlaneCoupler& c) : coupler(c) {}
+  void add_plane(int i, std::array<double*, 3> plane) const override {
+    coupler.add_plane(i, plane);
+  }
+};
+struct PlaneCouplerSampler final : fluid::PlaneSampler {
+  ib::PlaneCoupler& coupler;
+  explicit PlaneCouplerSampler(ib::PlaneCoupler& c) : coupler(c) {}
+  void sample_plane(int i, std::array<const double*, 3> plane) const override {
+    coupler.sample_plane(i, plane);
+  }
+};
+
 class Stepper {
  public:
   explicit Stepper(const StepperParams& p);
@@ -51,6 +72,7 @@ class Stepper {
   fluid::FluidSolver& fluid() { return *fluid_; }
   const fluid::FluidSolver& fluid() const { return *fluid_; }
   const ib::Coupler& coupler() const { return coupler_; }
+  ib::PlaneCoupler& plane_coupler() { return plane_coupler_; }
   interactions::Electrostatics& electrostatics() { return electro_; }
   interactions::Steric& steric() { return steric_; }
   const StepEnergies& last_energies() const { return last_; }
@@ -63,6 +85,7 @@ class Stepper {
   StepperParams p_;
   std::unique_ptr<fluid::FluidSolver> fluid_;
   ib::Coupler coupler_;
+  ib::PlaneCoupler plane_coupler_;
   interactions::Electrostatics electro_;
   interactions::Steric steric_;
   rod::RodWork work_;
