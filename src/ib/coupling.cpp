@@ -327,13 +327,46 @@ void PlaneCoupler::prepare(std::span<const Vec3> X, std::span<const Vec3> F,
   npoints_ = X.size();
   const std::int64_t npoints = std::int64_t(X.size());
   const std::size_t S = std::size_t(S_), P = std::size_t(P_);
+  if (m_ == 1) {
+    // c = h: the four nonzero weights of one dimension share one square root. With f the
+    // fractional part of X_d/h, the stencil entries q = 1..4 sit at r = −1−f, −f, 1−f, 2−f and
+    // MODEL (2.14) gives, with s = √(1 + 4f − 4f²) (the radicand of every branch there):
+    //   φ(−1−f) = (3 − 2f − s)/8, φ(−f) = (3 − 2f + s)/8, φ(1−f) = (1 + 2f + s)/8,
+    //   φ(2−f) = (1 + 2f − s)/8;  entries 0 and 5 (|r| ≥ 2) are zero. Equal to PointStencil's
+    // phi4 calls to round-off (test_plane_coupler.cpp), 6× fewer square roots.
+    const int n = grid_.n;
+    const double h = grid_.h();
+    const double inv_h = 1.0 / h, half_inv_h = 0.5 / h;
 #pragma omp parallel for schedule(static) if (X.size() >= kParallelMinPoints)
-  for (std::int64_t k = 0; k < npoints; ++k) {
-    const PointStencil st(X[k], grid_, m_);
-    for (int d = 0; d < 3; ++d) {
-      first_[3 * k + d] = st.idx[d][0];
-      std::copy_n(st.phi[d], S, phi_.begin() + (3 * k + d) * P);
-      std::copy_n(st.dphi[d], S, dphi_.begin() + (3 * k + d) * P);
+    for (std::int64_t k = 0; k < npoints; ++k) {
+      for (int d = 0; d < 3; ++d) {
+        const Locus loc = locate(X[k][d], h, n, 1);
+        const double f = loc.frac;
+        const double sq = std::sqrt(1.0 + 4.0 * f - 4.0 * f * f);
+        double* ph = phi_.data() + (3 * k + d) * P;
+        double* dp = dphi_.data() + (3 * k + d) * P;
+        const double w[6] = {0.0,
+                             (3.0 - 2.0 * f - sq) * 0.125 * inv_h,
+                             (3.0 - 2.0 * f + sq) * 0.125 * inv_h,
+                             (1.0 + 2.0 * f + sq) * 0.125 * inv_h,
+                             (1.0 + 2.0 * f - sq) * 0.125 * inv_h,
+                             0.0};
+        for (int q = 0; q < 6; ++q) {
+          ph[q] = w[q];
+          dp[q] = ((q < 5 ? w[q + 1] : 0.0) - (q > 0 ? w[q - 1] : 0.0)) * half_inv_h;
+        }
+        first_[3 * k + d] = loc.first;
+      }
+    }
+  } else {
+#pragma omp parallel for schedule(static) if (X.size() >= kParallelMinPoints)
+    for (std::int64_t k = 0; k < npoints; ++k) {
+      const PointStencil st(X[k], grid_, m_);
+      for (int d = 0; d < 3; ++d) {
+        first_[3 * k + d] = st.idx[d][0];
+        std::copy_n(st.phi[d], S, phi_.begin() + (3 * k + d) * P);
+        std::copy_n(st.dphi[d], S, dphi_.begin() + (3 * k + d) * P);
+      }
     }
   }
   // counting sort of (point, x entry) by x-plane, points ascending within a plane
