@@ -600,6 +600,10 @@ RunResult run(const Config& c_user, const RunOptions& opt) {
                     static_cast<long long>(total_steps), dt / 1e-9, grid_n, p.stepper.rod.n,
                     p.circle.excess_link, meta.threads, dir.c_str());
     say(buf);
+    if (distributed)
+      say("ibrod: the fluid grid is split over " + std::to_string(opt.ranks) + " MPI ranks (" +
+          std::to_string(grid_n / opt.ranks) + " x-planes each, " + std::to_string(meta.threads) +
+          " threads per rank); rank 0 writes the output");
   }
 
   // ---- the blow-up guard: stop with a diagnosis, keep the last good checkpoint
