@@ -21,6 +21,7 @@
 #include "exit_status.hpp"
 #include "io/bench.hpp"
 #include "io/config.hpp"
+#include "io/mpi_env.hpp"
 #include "io/run.hpp"
 
 namespace {
@@ -88,6 +89,19 @@ int main(int argc, char** argv) {
     return rc == 0 ? 0 : 2;
   }
 
+  // `mpirun -np K ibrod run`: MPI is initialised (only under a launcher) before anything can
+  // fail, so that every rank reaches the same error and exit status; K > 1 splits the fluid grid
+  // over the ranks (io/run.hpp). Without a launcher this is a one-process program, MPI untouched.
+  ibrod::io::mpi::World world;
+  if (*run) world = ibrod::io::mpi::init(&argc, &argv);
+  struct Finalize {
+    const ibrod::io::mpi::World& w;
+    ~Finalize() {
+      std::fflush(stdout);
+      ibrod::io::mpi::finalize(w);
+    }
+  } finalize{world};
+
   const bool resuming = *run && !resume_dir.empty();
   if (resuming) {
     config_path = (std::filesystem::path(resume_dir) / "config.toml").string();
@@ -117,14 +131,16 @@ int main(int argc, char** argv) {
     opt.resume = resuming;
     opt.force = force;
     opt.fftw_wisdom = wisdom;
+    opt.rank = world.rank;
+    opt.ranks = world.size;
     const ibrod::io::RunResult r = ibrod::io::run(c, opt);
-    if (r.signal != 0) {
+    if (r.signal != 0 && world.rank == 0) {
       std::fprintf(stderr,
                    "ibrod: stopped by signal %d at step %lld; checkpoint written. Continue with: "
                    "ibrod run --resume %s\n",
                    r.signal, static_cast<long long>(r.steps), out_dir.c_str());
-      return 128 + r.signal;
     }
+    if (r.signal != 0) return 128 + r.signal;
     return 0;
   } catch (const std::exception& e) {
     return ibrod::app::report_error(e);

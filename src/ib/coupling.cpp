@@ -143,8 +143,11 @@ inline void spread_row(double* __restrict fx, double* __restrict fy, double* __r
 //   x: (F_x p₁₂ + φ₁dφ₂ T_z/2) φ₃ − (p₁₂ T_y/2) dφ₃
 //   y: (F_y p₁₂ − dφ₁φ₂ T_z/2) φ₃ + (p₁₂ T_x/2) dφ₃
 //   z: (F_z p₁₂ + dφ₁φ₂ T_y/2 − φ₁dφ₂ T_x/2) φ₃
+// Slab: only the x-planes [x0, x0 + nx) are present, plane i at local index i − x0 (XSlab);
+// Slab = false is the whole grid (x0, nx unused).
+template <bool Slab>
 void spread_point(const PointStencil& st, const Vec3& F, const Vec3& T, const GridSpec& grid,
-                  const std::array<double*, 3>& f) {
+                  const std::array<double*, 3>& f, int x0, int nx) {
   const int S = st.S;
   const std::size_t n = std::size_t(grid.n);
   const double hTx = 0.5 * T[0], hTy = 0.5 * T[1], hTz = 0.5 * T[2];
@@ -152,6 +155,11 @@ void spread_point(const PointStencil& st, const Vec3& F, const Vec3& T, const Gr
   const int z0 = st.idx[2][0];
   const int len1 = std::min(S, grid.n - z0);
   for (int a = 0; a < S; ++a) {
+    int xi = st.idx[0][a];
+    if constexpr (Slab) {
+      xi -= x0;
+      if (unsigned(xi) >= unsigned(nx)) continue;  // not on this slab
+    }
     const double p1 = st.phi[0][a], d1 = st.dphi[0][a];
     for (int b = 0; b < S; ++b) {
       const double p12 = p1 * st.phi[1][b];
@@ -160,7 +168,7 @@ void spread_point(const PointStencil& st, const Vec3& F, const Vec3& T, const Gr
       const double Ax = F[0] * p12 + p1d2 * hTz, Bx = -p12 * hTy;
       const double Ay = F[1] * p12 - d1p2 * hTz, By = p12 * hTx;
       const double Az = F[2] * p12 + d1p2 * hTy - p1d2 * hTx;
-      const std::size_t row = (std::size_t(st.idx[0][a]) * n + std::size_t(st.idx[1][b])) * n;
+      const std::size_t row = (std::size_t(xi) * n + std::size_t(st.idx[1][b])) * n;
       spread_row(f[0] + row + z0, f[1] + row + z0, f[2] + row + z0, st.phi[2], st.dphi[2], len1,
                  Ax, Ay, Az, Bx, By);
       if (len1 < S) {
@@ -187,8 +195,10 @@ inline void interpolate_row(const double* __restrict ux, const double* __restric
 // Σ u w and Σ u × g over the stencil of one point (the sums of the file comment without h³),
 // by row sums: Σ_row u w = p₁₂ (s₀, s₁, s₂) and
 //   Σ_row u × g = (p₁₂ s₄ − φ₁dφ₂ s₂,  dφ₁φ₂ s₂ − p₁₂ s₃,  φ₁dφ₂ s₀ − dφ₁φ₂ s₁).
+template <bool Slab>
 void interpolate_point(const PointStencil& st, const GridSpec& grid,
-                       const std::array<const double*, 3>& u, Vec3& uw, Vec3& uxg) {
+                       const std::array<const double*, 3>& u, Vec3& uw, Vec3& uxg, int x0,
+                       int nx) {
   const int S = st.S;
   const std::size_t n = std::size_t(grid.n);
   const int z0 = st.idx[2][0];
@@ -197,9 +207,14 @@ void interpolate_point(const PointStencil& st, const GridSpec& grid,
   // store-to-load forwarding (a third of the time in a profile)
   double wx = 0, wy = 0, wz = 0, gx = 0, gy = 0, gz = 0;
   for (int a = 0; a < S; ++a) {
+    int xi = st.idx[0][a];
+    if constexpr (Slab) {
+      xi -= x0;
+      if (unsigned(xi) >= unsigned(nx)) continue;  // not on this slab
+    }
     const double p1 = st.phi[0][a], d1 = st.dphi[0][a];
     for (int b = 0; b < S; ++b) {
-      const std::size_t row = (std::size_t(st.idx[0][a]) * n + std::size_t(st.idx[1][b])) * n;
+      const std::size_t row = (std::size_t(xi) * n + std::size_t(st.idx[1][b])) * n;
       double s[5] = {0, 0, 0, 0, 0};
       interpolate_row(u[0] + row + z0, u[1] + row + z0, u[2] + row + z0, st.phi[2], st.dphi[2],
                       len1, s);
@@ -224,7 +239,11 @@ void interpolate_point(const PointStencil& st, const GridSpec& grid,
 
 }  // namespace
 
-Coupler::Coupler(const GridSpec& grid, int kernel_width) : grid_(grid), m_(kernel_width) {
+Coupler::Coupler(const GridSpec& grid, int kernel_width)
+    : Coupler(grid, kernel_width, XSlab{0, grid.n}) {}
+
+Coupler::Coupler(const GridSpec& grid, int kernel_width, XSlab slab)
+    : grid_(grid), m_(kernel_width), slab_(slab) {
   if (m_ < 1 || m_ > kMaxKernelWidth) {
     throw std::invalid_argument("ib::Coupler: kernel width m = " + std::to_string(m_) +
                                 " (c = m h) must be an integer in [1, " +
@@ -240,6 +259,13 @@ Coupler::Coupler(const GridSpec& grid, int kernel_width) : grid_(grid), m_(kerne
                                 std::to_string(stencil()) + " grid points, more than n = " +
                                 std::to_string(grid_.n));
   }
+  if (slab_.begin < 0 || slab_.begin >= grid_.n || slab_.count < 1 || slab_.count > grid_.n) {
+    throw std::invalid_argument("ib::Coupler: x slab [" + std::to_string(slab_.begin) + ", " +
+                                std::to_string(slab_.begin) + " + " +
+                                std::to_string(slab_.count) + ") is not within a grid of n = " +
+                                std::to_string(grid_.n) + " planes");
+  }
+  whole_ = slab_.begin == 0 && slab_.count == grid_.n;
   // Slabs at least S wide, so a stencil starting in slab b ends in slab b or b + 1; an even count
   // (or one) so that slabs of equal parity never touch, also across the periodic seam.
   const int n = grid_.n;
@@ -251,6 +277,14 @@ Coupler::Coupler(const GridSpec& grid, int kernel_width) : grid_(grid), m_(kerne
     const int end = int(std::int64_t(b + 1) * n / nslabs_);
     for (int i = begin; i < end; ++i) slab_of_[std::size_t(i)] = b;
   }
+}
+
+bool Coupler::touches_slab(int first) const {
+  // the stencil covers first … first + S − 1 (mod n), the slab begin … begin + count − 1
+  const int n = grid_.n;
+  const int d1 = (slab_.begin - first + n) % n;  // slab start seen from the stencil start
+  const int d2 = (first - slab_.begin + n) % n;  // stencil start seen from the slab start
+  return d1 < stencil() || d2 < slab_.count;
 }
 
 void Coupler::spread(std::span<const Vec3> X, std::span<const Vec3> F, std::span<const Vec3> T,
@@ -269,9 +303,17 @@ void Coupler::spread(std::span<const Vec3> X, std::span<const Vec3> F, std::span
 #pragma omp parallel for schedule(dynamic, 1) if (parallel)
     for (int b = parity; b < nslabs_; b += 2) {
       for (std::int64_t k = 0; k < npoints; ++k) {
-        if (slab_of_[std::size_t(locate(X[k][0], h, grid_.n, m_).first)] != b) continue;
-        const PointStencil st(X[k], grid_, m_);
-        spread_point(st, F[k], torques ? T[k] : Vec3::Zero().eval(), grid_, f);
+        const int first = locate(X[k][0], h, grid_.n, m_).first;
+        if (slab_of_[std::size_t(first)] != b) continue;
+        if (whole_) {
+          const PointStencil st(X[k], grid_, m_);
+          spread_point<false>(st, F[k], torques ? T[k] : Vec3::Zero().eval(), grid_, f, 0, 0);
+        } else if (touches_slab(first)) {
+          // the same writes as the whole grid's, less those off the slab: race-free alike
+          const PointStencil st(X[k], grid_, m_);
+          spread_point<true>(st, F[k], torques ? T[k] : Vec3::Zero().eval(), grid_, f,
+                             slab_.begin, slab_.count);
+        }
       }
     }
   }
@@ -284,12 +326,21 @@ void Coupler::interpolate(std::span<const Vec3> X, std::array<const double*, 3> 
   check_positions(X, grid_.h());
   const bool rotation = !W.empty();
   const std::int64_t npoints = std::int64_t(X.size());
-  const double h3 = grid_.h() * grid_.h() * grid_.h();
+  const double h = grid_.h();
+  const double h3 = h * h * h;
 #pragma omp parallel for schedule(static) if (X.size() >= kParallelMinPoints)
   for (std::int64_t k = 0; k < npoints; ++k) {
-    const PointStencil st(X[k], grid_, m_);
     Vec3 uw, uxg;
-    interpolate_point(st, grid_, u, uw, uxg);
+    if (whole_) {
+      const PointStencil st(X[k], grid_, m_);
+      interpolate_point<false>(st, grid_, u, uw, uxg, 0, 0);
+    } else if (touches_slab(locate(X[k][0], h, grid_.n, m_).first)) {
+      const PointStencil st(X[k], grid_, m_);
+      interpolate_point<true>(st, grid_, u, uw, uxg, slab_.begin, slab_.count);
+    } else {
+      uw.setZero();  // no stencil point on this slab
+      uxg.setZero();
+    }
     U[std::size_t(k)] = uw * h3;  // MODEL §4: U = Σ u δ_c h³
     // MODEL §4: W = ½ Σ (curl_h u) δ_c h³ = ½ Σ u × ∇_h δ_c h³ (summation by parts)
     if (rotation) W[std::size_t(k)] = uxg * (0.5 * h3);

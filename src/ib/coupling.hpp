@@ -27,6 +27,14 @@ double phi4(double r);
 /// δ_c(x) with c = m·h: c⁻³ φ(x₁/c) φ(x₂/c) φ(x₃/c), Å⁻³.
 double delta(const Vec3& x, double c);
 
+/// A range of x-planes [begin, begin + count) of the periodic grid (0 ≤ begin < n, 1 ≤ count ≤ n).
+/// A Coupler restricted to it reads and writes arrays that hold these planes only, global point
+/// (i, j, k) at ((i − begin) n + j) n + k: the slab of one MPI rank (fluid::DistributedFluid).
+struct XSlab {
+  int begin = 0;
+  int count = 0;
+};
+
 /// Spreading and interpolation for one grid and kernel width. Copyable and without mutable
 /// state, so its const member functions may be called concurrently. Neither spread() nor
 /// interpolate() allocates. Both run OpenMP-parallel (see spread() for how it avoids races) and
@@ -40,6 +48,13 @@ class Coupler {
   /// m > kMaxKernelWidth, 4m + 2 > grid.n (the stencil would overlap its own periodic image) or
   /// a grid with L ≤ 0.
   Coupler(const GridSpec& grid, int kernel_width);
+  /// Restricted to the x-planes of `slab` (see XSlab): spread() adds only the contributions that
+  /// fall on these planes, interpolate() sums only over them (partial U, W; the sum over slabs
+  /// that tile the grid is the whole-grid result up to round-off). No halo is needed: W uses
+  /// u × ∇_h δ at the stencil points only. Also throws std::invalid_argument for a bad slab. A
+  /// slab of all n planes from 0 is the whole grid (the same code and bits as the constructor
+  /// above).
+  Coupler(const GridSpec& grid, int kernel_width, XSlab slab);
 
   const GridSpec& grid() const { return grid_; }
   int kernel_width() const { return m_; }
@@ -47,10 +62,12 @@ class Coupler {
   /// grid points per dimension that one point touches when spreading (support of φ plus the
   /// one-point halo of the curl): 4m + 2
   int stencil() const { return 4 * m_ + 2; }
+  /// the x-planes the arrays hold ({0, n}: the whole grid)
+  XSlab slab() const { return slab_; }
 
   /// Accumulates (+=) the force density of point forces F and torques T at X into f
   /// (g Å⁻² s⁻²). T may be empty (no torques). f: three distinct, non-overlapping arrays of
-  /// grid().size() values, layout GridSpec::index. Throws std::invalid_argument if F (or a
+  /// grid().size() values, layout GridSpec::index (slab(): only its planes, see XSlab). Throws std::invalid_argument if F (or a
   /// non-empty T) differs in size from X, ibrod::RunError if a position is not finite or absurdly
   /// far out (|X_d| > 2⁴⁰ h).
   /// Race-free in parallel: the x axis is cut into an even number of slabs at least 4m + 2 wide,
@@ -60,7 +77,8 @@ class Coupler {
               std::array<double*, 3> f) const;
 
   /// Overwrites U (Å s⁻¹) and W (s⁻¹) with the interpolated velocity and angular velocity at X.
-  /// W may be empty (not computed). u: three arrays of grid().size() values. Throws as spread()
+  /// W may be empty (not computed). u: three arrays of grid().size() values (slab(): its
+  /// planes). Throws as spread()
   /// (U, and W unless empty, must have X's size).
   void interpolate(std::span<const Vec3> X, std::array<const double*, 3> u, std::span<Vec3> U,
                    std::span<Vec3> W) const;
@@ -70,6 +88,10 @@ class Coupler {
   int m_;
   int nslabs_;                 ///< x slabs for race-free parallel spreading (1 or even)
   std::vector<int> slab_of_;   ///< [n] slab of each x index
+  XSlab slab_;                 ///< the x-planes of the arrays
+  bool whole_ = true;          ///< slab_ is the whole grid
+  /// true if the stencil of a point whose first wrapped x index is `first` meets slab_
+  bool touches_slab(int first) const;
 };
 
 /// Spreading and interpolation one x-plane at a time, for a fluid solver that assembles its

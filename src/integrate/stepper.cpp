@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <array>
+#include <stdexcept>
+#include <utility>
 
 namespace ibrod::integrate {
 
@@ -13,12 +15,27 @@ namespace {
 void set_threads(int threads) {
   if (threads > 0) omp_set_num_threads(threads);
 }
+
+std::unique_ptr<fluid::FluidSolver> make_serial(const StepperParams& p) {
+  if (p.distributed) return nullptr;
+  return std::make_unique<fluid::FluidSolver>(p.grid, p.fluid, p.threads, p.plan_measure);
+}
+
+std::unique_ptr<fluid::DistributedFluid> make_distributed(const StepperParams& p) {
+  if (!p.distributed) return nullptr;
+  return std::make_unique<fluid::DistributedFluid>(p.grid, p.fluid, p.threads, p.plan_measure);
+}
+
+ib::XSlab slab_of(const GridSpec& grid, const fluid::DistributedFluid* d) {
+  return d ? ib::XSlab{d->x_begin(), d->x_count()} : ib::XSlab{0, grid.n};
+}
 }  // namespace
 
 Stepper::Stepper(const StepperParams& p)
     : p_((set_threads(p.threads), p)),
-      fluid_(std::make_unique<fluid::FluidSolver>(p.grid, p.fluid, p.threads, p.plan_measure)),
-      coupler_(p.grid, p.kernel_width),
+      fluid_(make_serial(p)),
+      dist_(make_distributed(p)),
+      coupler_(p.grid, p.kernel_width, slab_of(p.grid, dist_.get())),
       plane_coupler_(coupler_, p.rod.n),
       electro_(p.electro, p.rod.n),
       steric_(p.steric, p.rod.n) {
@@ -28,6 +45,18 @@ Stepper::Stepper(const StepperParams& p)
   T_.resize(n);
   U_.resize(n);
   W_.resize(n);
+  if (dist_) UW_.resize(6 * std::size_t(n));
+}
+
+Stepper::~Stepper() = default;
+
+const fluid::FluidSolver* Stepper::serial_fluid() const {
+  if (!fluid_)
+    throw std::logic_error("Stepper::fluid(): the fluid is distributed over MPI ranks");
+  return fluid_.get();
+}
+fluid::FluidSolver* Stepper::serial_fluid() {
+  return const_cast<fluid::FluidSolver*>(std::as_const(*this).serial_fluid());
 }
 
 StepEnergies Stepper::compute_forces(const rod::RodState& s) {
@@ -43,6 +72,28 @@ StepEnergies Stepper::compute_forces(const rod::RodState& s) {
 
 void Stepper::step(rod::RodState& s) {
   last_ = compute_forces(s);
+  if (dist_) {
+    // the same step on this rank's x-slab; U, W are partial sums until summed over the ranks
+    dist_->begin_step();
+    coupler_.spread(s.X, F_, T_, dist_->force());
+    dist_->finish_step();
+    const fluid::DistributedFluid& fl = *dist_;
+    coupler_.interpolate(s.X, fl.velocity(), U_, W_);
+    const std::size_t n = U_.size();
+    for (std::size_t k = 0; k < n; ++k)
+      for (int d = 0; d < 3; ++d) {
+        UW_[3 * k + d] = U_[k][d];
+        UW_[3 * (n + k) + d] = W_[k][d];
+      }
+    dist_->sum_over_ranks(UW_.data(), UW_.size());
+    for (std::size_t k = 0; k < n; ++k)
+      for (int d = 0; d < 3; ++d) {
+        U_[k][d] = UW_[3 * k + d];
+        W_[k][d] = UW_[3 * (n + k) + d];
+      }
+    rod::advance(s, U_, W_, p_.fluid.dt);
+    return;
+  }
   // fⁿ = spread(F, T) is added to r = ρuⁿ/Δt − ρS_h(uⁿ) plane by plane inside the fluid step
   // (MODEL §4), and U, W at Xⁿ are sampled from uⁿ⁺¹ plane by plane: the kernel weights are
   // evaluated once, and no grid-sized pass is spent on either
@@ -50,6 +101,29 @@ void Stepper::step(rod::RodState& s) {
   fluid_->step(PlaneCouplerForcing(plane_coupler_), PlaneCouplerSampler(plane_coupler_));
   plane_coupler_.finish_interpolation(U_, W_);
   rod::advance(s, U_, W_, p_.fluid.dt);
+}
+
+double Stepper::fluid_kinetic_energy() const {
+  return dist_ ? dist_->kinetic_energy() : fluid_->kinetic_energy();
+}
+
+int Stepper::fluid_threads() const { return dist_ ? dist_->threads() : fluid_->threads(); }
+
+std::array<const double*, 3> Stepper::whole_velocity(std::vector<double>& scratch) const {
+  if (!dist_) return {fluid_->velocity(0), fluid_->velocity(1), fluid_->velocity(2)};
+  dist_->gather_velocity(scratch);
+  if (dist_->rank() != 0) return {nullptr, nullptr, nullptr};
+  const std::size_t n3 = p_.grid.size();
+  return {scratch.data(), scratch.data() + n3, scratch.data() + 2 * n3};
+}
+
+void Stepper::set_whole_velocity(std::array<const double*, 3> u) {
+  if (dist_) {
+    dist_->scatter_velocity(u);
+    return;
+  }
+  const std::size_t n3 = p_.grid.size();
+  for (int c = 0; c < 3; ++c) std::copy_n(u[c], n3, fluid_->velocity(c));
 }
 
 }  // namespace ibrod::integrate

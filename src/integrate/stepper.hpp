@@ -9,11 +9,20 @@
 //   4. interpolate U, W at Xⁿ from uⁿ⁺¹: the planes' shares added in a fixed order
 //   5. move: X += Δt U, D ← R(Δt W) D
 // Buffers are sized once; step() allocates nothing.
+//
+// With StepperParams::distributed (`mpirun -np K ibrod run`, built with MPI) the fluid is a
+// fluid::DistributedFluid split in x-slabs over the K ranks and the rod work is replicated: every
+// rank computes all rod forces, spreads every point into its own planes only and interpolates
+// from its own planes only (ib::XSlab); the partial U, W are then summed over the ranks in rank
+// order on every rank (DistributedFluid::sum_over_ranks: MPI_Allgather + the same additions
+// everywhere), so every rank holds bitwise the same rod state after each step. (The distributed
+// step uses the whole-grid Coupler restricted to the rank's slab, not the PlaneCoupler.)
 #include <array>
 #include <memory>
 #include <vector>
 
 #include "core/grid.hpp"
+#include "fluid/distributed_fluid.hpp"
 #include "fluid/navier_stokes.hpp"
 #include "ib/coupling.hpp"
 #include "interactions/interactions.hpp"
@@ -30,6 +39,8 @@ struct StepperParams {
   interactions::StericParams steric;
   int threads = 0;            ///< OpenMP/FFTW threads, 0 = OpenMP default
   bool plan_measure = true;   ///< FFTW_MEASURE plans (slower start, faster steps)
+  /// the fluid split over the ranks of MPI_COMM_WORLD (MPI initialised; see the file comment)
+  bool distributed = false;
 };
 
 /// Potential energies at the force evaluation of the latest step (the state before the move),
@@ -61,6 +72,7 @@ struct PlaneCouplerSampler final : fluid::PlaneSampler {
 class Stepper {
  public:
   explicit Stepper(const StepperParams& p);
+  ~Stepper();
 
   /// Advance rod and fluid by one Δt.
   void step(rod::RodState& s);
@@ -69,8 +81,26 @@ class Stepper {
   StepEnergies compute_forces(const rod::RodState& s);
 
   const StepperParams& params() const { return p_; }
-  fluid::FluidSolver& fluid() { return *fluid_; }
-  const fluid::FluidSolver& fluid() const { return *fluid_; }
+  /// The serial fluid solver (not distributed(); throws std::logic_error otherwise).
+  fluid::FluidSolver& fluid() { return *serial_fluid(); }
+  const fluid::FluidSolver& fluid() const { return *serial_fluid(); }
+  /// The fluid shared by the MPI ranks (distributed() only, else nullptr).
+  fluid::DistributedFluid* distributed_fluid() { return dist_.get(); }
+  const fluid::DistributedFluid* distributed_fluid() const { return dist_.get(); }
+  bool distributed() const { return dist_ != nullptr; }
+  /// rank 0 of the distributed fluid, or the only process
+  bool root() const { return !dist_ || dist_->rank() == 0; }
+
+  // The fluid, whichever it is (collective calls when distributed():
+  // every rank must make them in the same order).
+  /// ½ρ Σ|u|² h³ of the whole grid, g Å² s⁻² (collective; the same bits on every rank)
+  double fluid_kinetic_energy() const;
+  int fluid_threads() const;
+  /// The whole velocity (3 arrays of n³ values, GridSpec::index): the serial solver's own
+  /// arrays, or (collective) gathered into `scratch` on rank 0; nullptrs on the other ranks.
+  std::array<const double*, 3> whole_velocity(std::vector<double>& scratch) const;
+  /// Sets the fluid velocity from the whole grid (every rank passes it; collective).
+  void set_whole_velocity(std::array<const double*, 3> u);
   const ib::Coupler& coupler() const { return coupler_; }
   ib::PlaneCoupler& plane_coupler() { return plane_coupler_; }
   interactions::Electrostatics& electrostatics() { return electro_; }
@@ -83,14 +113,18 @@ class Stepper {
 
  private:
   StepperParams p_;
-  std::unique_ptr<fluid::FluidSolver> fluid_;
+  std::unique_ptr<fluid::FluidSolver> fluid_;      // serial, or
+  std::unique_ptr<fluid::DistributedFluid> dist_;  // distributed
   ib::Coupler coupler_;
   ib::PlaneCoupler plane_coupler_;
   interactions::Electrostatics electro_;
   interactions::Steric steric_;
   rod::RodWork work_;
   std::vector<Vec3> F_, T_, U_, W_;
+  std::vector<double> UW_;  // distributed: U and W packed for the sum over ranks
   StepEnergies last_;
+  const fluid::FluidSolver* serial_fluid() const;
+  fluid::FluidSolver* serial_fluid();
 };
 
 }  // namespace ibrod::integrate

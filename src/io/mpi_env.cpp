@@ -63,6 +63,30 @@ long long max(long long v) {
   return v;
 }
 
+long long broadcast(long long v) {
+#ifdef IBROD_MPI
+  int on = 0;
+  MPI_Initialized(&on);
+  if (on) MPI_Bcast(&v, 1, MPI_LONG_LONG, 0, MPI_COMM_WORLD);
+#endif
+  return v;
+}
+
+std::string broadcast(const std::string& s) {
+#ifdef IBROD_MPI
+  int on = 0;
+  MPI_Initialized(&on);
+  if (on) {
+    long long len = broadcast(static_cast<long long>(s.size()));
+    std::string out = s;
+    out.resize(std::size_t(len));
+    MPI_Bcast(out.data(), int(len), MPI_CHAR, 0, MPI_COMM_WORLD);
+    return out;
+  }
+#endif
+  return s;
+}
+
 void finalize([[maybe_unused]] const World& w) {
 #ifdef IBROD_MPI
   if (w.initialized) MPI_Finalize();

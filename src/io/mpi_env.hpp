@@ -3,6 +3,8 @@
 // initialises MPI only when started by a launcher (`mpirun -np K ibrod …`), so that a plain
 // `ibrod run`, and every run a sweep spawns, stays a one-process program without MPI.
 // Without IBROD_MPI every function here is the one-rank answer.
+#include <string>
+
 namespace ibrod::io::mpi {
 
 /// true if built with MPI (IBROD_MPI).
@@ -24,6 +26,10 @@ World init(int* argc, char*** argv);
 long long sum(long long v);
 /// Maximum of v over the ranks.
 long long max(long long v);
+/// rank 0's v on every rank (v itself without MPI).
+long long broadcast(long long v);
+/// rank 0's s on every rank (s itself without MPI).
+std::string broadcast(const std::string& s);
 /// MPI_Finalize if init() initialised MPI.
 void finalize(const World& w);
 

@@ -1,22 +1,27 @@
 #include "io/run.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
+#include <stdexcept>
 
 #include "core/error.hpp"
+#include "fluid/distributed_fluid.hpp"
 #include "fluid/fftw_wisdom.hpp"
 #include "io/atomic_file.hpp"
 #include "io/checkpoint.hpp"
 #include "io/h5md.hpp"
+#include "io/mpi_env.hpp"
 #include "io/npy.hpp"
 #include "io/progress.hpp"
 #include "io/vtk.hpp"
@@ -101,6 +106,42 @@ class SignalGuard {
 
 const char* signal_name(int s) {
   return s == SIGINT ? "SIGINT" : s == SIGTERM ? "SIGTERM" : "a signal";
+}
+
+// ---------------------------------------------------------------------------------------------
+// Under MPI (opt.ranks > 1) rank 0 alone writes files. What it writes may fail (disk full, an
+// output directory in the way) while the other ranks carry on into the next collective and wait
+// forever: on_root runs f on rank 0 only and then every rank throws what rank 0 threw (the same
+// type, ConfigError, RunError or std::runtime_error, and message), so that all ranks stop at the
+// same point with the same exit status. One broadcast per call; without MPI it is f().
+
+void on_root(const RunOptions& opt, const std::function<void()>& f) {
+  if (opt.ranks <= 1) {
+    f();
+    return;
+  }
+  long long kind = 0;
+  std::string what;
+  if (opt.rank == 0) {
+    try {
+      f();
+    } catch (const ConfigError& e) {
+      kind = 2;
+      what = e.what();
+    } catch (const RunError& e) {
+      kind = 3;
+      what = e.what();
+    } catch (const std::exception& e) {
+      kind = 1;
+      what = e.what();
+    }
+  }
+  kind = mpi::broadcast(kind);
+  if (kind == 0) return;
+  what = mpi::broadcast(what);
+  if (kind == 2) throw ConfigError(what);
+  if (kind == 3) throw RunError(what);
+  throw std::runtime_error(what);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -259,16 +300,13 @@ class RunFiles {
     if (h5_) h5_->write_observables(o);
   }
 
-  void frame(sim::Simulation& sim) {
+  // u: the whole fluid velocity (Stepper::whole_velocity), read only with output.fluid_vti
+  void frame(const sim::Simulation& sim, std::array<const double*, 3> u) {
     if (!frames_on_) return;
     const double t_us = sim.time() / 1e-6;
     h5_->write_frame(sim.step_count(), t_us, sim.rod());
     rod_pvd_.add(sim.step_count(), t_us, rod_vtp(sim.rod(), ds_));
-    if (vti_) {
-      const auto& fl = sim.stepper().fluid();
-      fluid_pvd_.add(sim.step_count(), t_us,
-                     fluid_vti(fl.grid(), {fl.velocity(0), fl.velocity(1), fl.velocity(2)}));
-    }
+    if (vti_) fluid_pvd_.add(sim.step_count(), t_us, fluid_vti(sim.params().stepper.grid, u));
   }
 
   std::int64_t frames() const { return h5_ ? h5_->frames() : 0; }
@@ -366,8 +404,17 @@ RunResult run(const Config& c_user, const RunOptions& opt) {
   const fs::path dir(opt.output_dir);
   const std::string config_text = to_toml(c_user);
   Config c = c_user;
-  Progress progress(opt.log, opt.tty);
+  // under MPI: rank 0 alone prints and writes; every rank steps (see RunOptions::rank)
+  const bool root = opt.rank == 0;
+  const bool distributed = opt.ranks > 1;
+  Progress progress(root ? opt.log : nullptr, opt.tty);
   auto say = [&](const std::string& s) { progress.message(s); };
+  if (distributed && c.grid_n % opt.ranks != 0)
+    throw ConfigError("run: grid.n = " + std::to_string(c.grid_n) + " cannot be split over " +
+                      std::to_string(opt.ranks) + " MPI ranks: each rank holds grid.n/K x-planes "
+                      "of the fluid, so the rank count K of `mpirun -np K` must divide grid.n");
+  if (distributed && !fluid::distributed_available())
+    throw ConfigError("run: this ibrod was built without FFTW MPI; run it without mpirun");
 
   if (!opt.fftw_wisdom.empty() && !fluid::import_wisdom(opt.fftw_wisdom))
     throw ConfigError("run: cannot read FFTW wisdom from '" + opt.fftw_wisdom + "'");
@@ -412,10 +459,12 @@ RunResult run(const Config& c_user, const RunOptions& opt) {
     }
     // the same threads as the run that wrote the checkpoint: the same round-off
     if (c.run_threads == 0) c.run_threads = ck->meta.threads;
-    if (config_changed) write_file_atomic(dir / "config.toml", config_text);
+    if (config_changed) on_root(opt, [&] { write_file_atomic(dir / "config.toml", config_text); });
   } else {
-    prepare_output_dir(dir, opt.overwrite);
-    write_file_atomic(dir / "config.toml", config_text);
+    on_root(opt, [&] {
+      prepare_output_dir(dir, opt.overwrite);
+      write_file_atomic(dir / "config.toml", config_text);
+    });
   }
 
   SignalGuard signals(opt.handle_signals);
@@ -430,15 +479,25 @@ RunResult run(const Config& c_user, const RunOptions& opt) {
           "; FFTW may choose other plans than before, so the continued run may differ from an "
           "uninterrupted one in the last bits");
   }
-  sim::Simulation sim(to_params(c));
-  {
+  sim::SimParams sp = to_params(c);
+  sp.stepper.distributed = distributed;
+  std::optional<sim::Simulation> sim_holder;
+  try {
+    sim_holder.emplace(sp);
+  } catch (const std::invalid_argument& e) {
+    if (!distributed) throw;
+    // the distributed fluid checks what every rank sees alike: a bad input on every rank
+    throw ConfigError(std::string("run: ") + e.what());
+  }
+  sim::Simulation& sim = *sim_holder;
+  on_root(opt, [&] {  // distributed: rank 0 holds every rank's plans (fftw_mpi_gather_wisdom)
     const fs::path tmp = wisdom.string() + ".tmp";
     if (!fluid::export_wisdom(tmp.string()) || std::rename(tmp.c_str(), wisdom.c_str()) != 0) {
       std::error_code ec;
       fs::remove(tmp, ec);
       throw RunError("output: cannot write " + wisdom.string() + " (disk full?)");
     }
-  }
+  });
   const auto& p = sim.params();
   const double dt = p.stepper.fluid.dt;
   const auto total_steps = std::int64_t(std::ceil(p.t_end / dt - 0.5));
@@ -450,22 +509,35 @@ RunResult run(const Config& c_user, const RunOptions& opt) {
     meta = ck->meta;
     ++meta.resumes;
     sim.rod() = ck->rod;
-    auto& fl = sim.stepper().fluid();
-    const std::size_t n3 = fl.grid().size();
-    for (int comp = 0; comp < 3; ++comp)
-      std::copy_n(ck->velocity.data() + comp * n3, n3, fl.velocity(comp));
+    const std::size_t n3 = sp.stepper.grid.size();
+    const double* v = ck->velocity.data();
+    sim.stepper().set_whole_velocity({v, v + n3, v + 2 * n3});
     sim.restore_step_count(ck->meta.step);
     r.initial = meta.initial;
     r.resumed_from = r.checkpoint_step = meta.step;
     ck.reset();  // the state lives in sim now; free the copy
   }
   meta.config_toml = config_text;
-  meta.threads = sim.stepper().fluid().threads();
+  meta.threads = sim.stepper().fluid_threads();
   meta.stop_reason = "none";
   const double wall_before = meta.wall_s;
 
-  RunFiles files(dir, c, sim, r.resumed_from, config_text, progress);
-
+  std::unique_ptr<RunFiles> files;  // rank 0 only
+  on_root(opt, [&] {
+    files = std::make_unique<RunFiles>(dir, c, sim, r.resumed_from, config_text, progress);
+  });
+  // distributed: the whole velocity gathered on rank 0 for checkpoints, .vti frames, .npy
+  std::vector<double> gathered;
+  const bool frames_on = frame_every(c) > 0;
+  auto write_frame = [&] {
+    if (!frames_on) return;
+    std::array<const double*, 3> u{};
+    if (c.output_fluid_vti) u = sim.stepper().whole_velocity(gathered);
+    on_root(opt, [&] { files->frame(sim, u); });
+  };
+  auto ensure_space = [&](std::uintmax_t bytes) {
+    on_root(opt, [&] { files->ensure_space(bytes); });
+  };
   const auto loop_start = Clock::now();
   const std::int64_t start_step = sim.step_count();
   auto seconds_since = [](Clock::time_point t) {
@@ -475,9 +547,8 @@ RunResult run(const Config& c_user, const RunOptions& opt) {
     meta.step = sim.step_count();
     meta.stop_reason = stop_reason;
     meta.wall_s = wall_before + seconds_since(t0);
-    const auto& fl = sim.stepper().fluid();
-    write_checkpoint(dir / "checkpoint.bin", meta, sim.rod(), grid_n,
-                     {fl.velocity(0), fl.velocity(1), fl.velocity(2)});
+    const auto u = sim.stepper().whole_velocity(gathered);
+    on_root(opt, [&] { write_checkpoint(dir / "checkpoint.bin", meta, sim.rod(), grid_n, u); });
     r.checkpoint_step = meta.step;
   };
   auto finish = [&](const sim::Observables& o, const std::string& stop_reason,
@@ -491,11 +562,15 @@ RunResult run(const Config& c_user, const RunOptions& opt) {
     r.link_drift = o.link - r.initial.link;
     r.max_link_drift = meta.max_link_drift;
     r.self_passage_warning = meta.self_passage_warning;
-    if (error.empty()) write_file_atomic(dir / "final_state.csv", final_state_csv(sim.rod()));
-    if (error.empty() && stop_reason != "interrupted" && c.output_fluid_velocity)
-      write_velocity_npy(dir / "velocity.npy", sim.stepper().fluid());
-    write_file_atomic(dir / "summary.json",
-                      summary_json(c_user, r, meta, files.frames(), stop_reason, error));
+    const bool npy = error.empty() && stop_reason != "interrupted" && c.output_fluid_velocity;
+    std::array<const double*, 3> u{};
+    if (npy) u = sim.stepper().whole_velocity(gathered);
+    on_root(opt, [&] {
+      if (error.empty()) write_file_atomic(dir / "final_state.csv", final_state_csv(sim.rod()));
+      if (npy) write_velocity_npy(dir / "velocity.npy", grid_n, u[0], u[1], u[2]);
+      write_file_atomic(dir / "summary.json",
+                        summary_json(c_user, r, meta, files->frames(), stop_reason, error));
+    });
   };
   auto progress_line = [&](const sim::Observables& o) {
     const double ms = 1e3 * seconds_since(loop_start) /
@@ -525,6 +600,10 @@ RunResult run(const Config& c_user, const RunOptions& opt) {
                     static_cast<long long>(total_steps), dt / 1e-9, grid_n, p.stepper.rod.n,
                     p.circle.excess_link, meta.threads, dir.c_str());
     say(buf);
+    if (distributed)
+      say("ibrod: the fluid grid is split over " + std::to_string(opt.ranks) + " MPI ranks (" +
+          std::to_string(grid_n / opt.ranks) + " x-planes each, " + std::to_string(meta.threads) +
+          " threads per rank); rank 0 writes the output");
   }
 
   // ---- the blow-up guard: stop with a diagnosis, keep the last good checkpoint
@@ -586,14 +665,14 @@ RunResult run(const Config& c_user, const RunOptions& opt) {
   const std::int64_t fevery = frame_every(c);
   const std::int64_t cevery = c.output_checkpoint_every_steps;
   try {
-    files.ensure_space(reserve_bytes);
+    ensure_space(reserve_bytes);
     if (r.resumed_from < 0) {
       if (const std::string bad = rod_problem(sim.rod(), c.rod_rise_A); !bad.empty())
         blow_up("the initial state is not sane: " + bad);
       o = observe_checked();
       r.initial = meta.initial = o;
-      files.row(o);
-      files.frame(sim);
+      on_root(opt, [&] { files->row(o); });
+      write_frame();
       write_ckpt("none");
     } else {
       o = sim.observe();
@@ -601,7 +680,8 @@ RunResult run(const Config& c_user, const RunOptions& opt) {
 
     sim::StopReason reason = sim::StopReason::none;
     for (;;) {
-      if (const int sig = signals.pending()) {
+      // distributed: the ranks agree on a signal (each may see it after another step)
+      if (const int sig = distributed ? int(mpi::max(signals.pending())) : signals.pending()) {
         // the end of the current step: save it, then stop
         if (r.checkpoint_step != sim.step_count()) write_ckpt("none");
         progress.finish_line();
@@ -621,7 +701,7 @@ RunResult run(const Config& c_user, const RunOptions& opt) {
       const bool output_step = step % every == 0 || at_end;
       if (output_step) {
         o = observe_checked();
-        files.row(o);
+        on_root(opt, [&] { files->row(o); });
         check_link(o);
         reason = sim.stop_reason(o);
         if (at_end && reason == sim::StopReason::none) reason = sim::StopReason::end_time;
@@ -629,10 +709,10 @@ RunResult run(const Config& c_user, const RunOptions& opt) {
       const bool stop = reason != sim::StopReason::none;
       const bool frame_step = fevery > 0 && (step % fevery == 0 || stop);
       const bool ckpt_step = (cevery > 0 && step % cevery == 0) || stop;
-      if (frame_step) files.frame(sim);
+      if (frame_step) write_frame();
       if (ckpt_step) write_ckpt(stop ? sim::to_string(reason) : "none");
       // before the next step's writes: room for a new checkpoint beside the old one, frames
-      if (!stop && (output_step || frame_step || ckpt_step)) files.ensure_space(reserve_bytes);
+      if (!stop && (output_step || frame_step || ckpt_step)) ensure_space(reserve_bytes);
       const double now = seconds_since(loop_start);
       if (stop) {
         progress.update(progress_line(o), now, /*last=*/true);

@@ -43,7 +43,7 @@ Observables Simulation::observe() {
     o.dE_electro_kT = (e - electro_circle_) / kT;
   }
   if (p_.stepper.steric.enabled) o.E_steric_kT = stepper_.steric().energy(rod_.X) / kT;
-  o.E_kinetic_kT = stepper_.fluid().kinetic_energy() / kT;
+  o.E_kinetic_kT = stepper_.fluid_kinetic_energy() / kT;  // collective when distributed
   o.E_total_kT = o.E_bend_kT + o.E_twist_kT + o.E_stretch_kT + o.E_electro_kT + o.E_steric_kT +
                  o.E_kinetic_kT;
 
@@ -69,7 +69,7 @@ bool Simulation::finite() const {
   for (int k = 0; k < rod_.size(); ++k)
     if (!rod_.X[k].allFinite() || !rod_.D[k].allFinite()) return false;
   // a NaN or Inf anywhere in the fluid makes the kinetic energy non-finite
-  return std::isfinite(stepper_.fluid().kinetic_energy());
+  return std::isfinite(stepper_.fluid_kinetic_energy());
 }
 
 }  // namespace ibrod::sim
