@@ -125,7 +125,9 @@ class FluidSolver {
   FluidParams params_;
   std::array<double*, 3> u_{};                 // velocity, real space
   std::array<double*, 3> f_{};                 // force density, then right-hand side r
-  std::array<std::complex<double>*, 3> fh_{};  // r̂, then ûⁿ⁺¹, layout [x][y][k_z]
+  std::array<std::complex<double>*, 3> fh_{};  // r̂, then ûⁿ⁺¹, layout [x][y][k_z], x-stride
+                                               //   plane_c_ ≥ n(n/2+1) (padded, see constructor)
+  std::size_t plane_c_ = 0;
   double* plane_buf_ = nullptr;                // per thread: 3 real n×n planes of r
   bool force_zero_ = true;                     // f_ known to be all zero
   bool plan_measure_ = true;
