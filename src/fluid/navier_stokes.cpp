@@ -32,6 +32,10 @@ void init_fftw_threads() {
 
 fftw_plan as_plan(void* p) { return static_cast<fftw_plan>(p); }
 
+// doubles between the components of u, f and the plane buffer (constructor): 1088 bytes, a
+// multiple of 32 (FFTW's alignment) that puts the components' rows in different cache sets
+constexpr std::size_t kCompPad = 136;
+
 // Best effort throughout: a cache that cannot be read or written only costs planning time.
 void save_wisdom_cache(const std::string& path) {
   namespace fs = std::filesystem;
@@ -132,15 +136,21 @@ FluidSolver::FluidSolver(const GridSpec& grid, const FluidParams& params, int th
   const std::size_t nc = std::size_t(n) * plane_c_;  // component stride, complex values
   const std::size_t np = std::size_t(n) * n;  // points of one real x-plane
   plan_measure_ = plan_measure;
-  double* u = fftw_alloc_real(3 * nr);
-  double* f = fftw_alloc_real(3 * nr);
+  // The three components of u and f (and of the plane buffer) lie apart by their size plus
+  // kCompPad doubles: unpadded, they are a multiple of 4 KiB apart, and the rows that the
+  // advection pass reads of the three components of three x-planes (nine streams) all fall into
+  // the same sets of an 8-way first-level cache.
+  comp_r_ = nr + kCompPad;
+  comp_p_ = np + kCompPad;
+  double* u = fftw_alloc_real(3 * comp_r_);
+  double* f = fftw_alloc_real(3 * comp_r_);
   fftw_complex* fh = fftw_alloc_complex(3 * nc);
-  plane_buf_ = fftw_alloc_real(3 * np * std::size_t(threads_));
+  plane_buf_ = fftw_alloc_real(3 * comp_p_ * std::size_t(threads_));
   // Components are consecutive blocks of one allocation (howmany = 3 plans need a fixed
   // stride); n even makes every block start 32-byte aligned, like the base.
   for (int c = 0; c < 3; ++c) {
-    u_[c] = u ? u + c * nr : nullptr;
-    f_[c] = f ? f + c * nr : nullptr;
+    u_[c] = u ? u + c * comp_r_ : nullptr;
+    f_[c] = f ? f + c * comp_r_ : nullptr;
     fh_[c] = fh ? reinterpret_cast<std::complex<double>*>(fh + c * nc) : nullptr;
   }
   if (!u || !f || !fh || !plane_buf_) {
@@ -160,10 +170,11 @@ FluidSolver::FluidSolver(const GridSpec& grid, const FluidParams& params, int th
   fftw_iodim many[2] = {{nzh, 1, 1}, {3, int(nc), int(nc)}};  // k_z, then the component
   auto make_plans = [&](unsigned fl) {
     fftw_plan_with_nthreads(1);
-    plan_plane_r2c_ = fftw_plan_many_dft_r2c(2, plane_dims, 3, plane_buf_, nullptr, 1, int(np),
+    plan_plane_r2c_ = fftw_plan_many_dft_r2c(2, plane_dims, 3, plane_buf_, nullptr, 1,
+                                             int(comp_p_),
                                              fh, nullptr, 1, int(nc), fl);
     plan_plane_c2r_ = fftw_plan_many_dft_c2r(2, plane_dims, 3, fh, nullptr, 1, int(nc), u,
-                                             nullptr, 1, int(nr), fl);
+                                             nullptr, 1, int(comp_r_), fl);
     bool ok = plan_plane_r2c_ && plan_plane_c2r_;
     for (int par = 0; par < 2; ++par) {
       fftw_complex* slice = fh + par * nzh;
@@ -181,8 +192,8 @@ FluidSolver::FluidSolver(const GridSpec& grid, const FluidParams& params, int th
     throw std::runtime_error("FluidSolver: FFTW planning failed");
   }
   // FFTW_MEASURE scribbles on the buffers while planning: start from rest only afterwards.
-  std::fill(u, u + 3 * nr, 0.0);
-  std::fill(f, f + 3 * nr, 0.0);
+  std::fill(u, u + 3 * comp_r_, 0.0);
+  std::fill(f, f + 3 * comp_r_, 0.0);
   force_zero_ = true;
 }
 
@@ -210,7 +221,7 @@ void FluidSolver::release() {
 }
 
 void FluidSolver::zero_force() {
-  const std::ptrdiff_t total = std::ptrdiff_t(3 * grid_.size());
+  const std::ptrdiff_t total = std::ptrdiff_t(3 * comp_r_);  // the pads too: they stay zero
   double* f = f_[0];
 #pragma omp parallel for simd num_threads(threads_) schedule(static)
   for (std::ptrdiff_t i = 0; i < total; ++i) f[i] = 0.0;
@@ -255,8 +266,8 @@ void FluidSolver::pass_rhs_planes(const PlaneForcing* forcing) {
   };
 #pragma omp parallel for num_threads(threads_) schedule(static)
   for (int i = 0; i < n; ++i) {
-    double* buf = plane_buf_ + 3 * np * std::size_t(omp_get_thread_num());
-    const std::array<double*, 3> r{buf, buf + np, buf + 2 * np};
+    double* buf = plane_buf_ + 3 * comp_p_ * std::size_t(omp_get_thread_num());
+    const std::array<double*, 3> r{buf, buf + comp_p_, buf + 2 * comp_p_};
     // r = ρuⁿ/Δt − ρS_h(uⁿ) + fⁿ (MODEL §4): fⁿ from the force array if it was written (the
     // plane zeroed behind), plus the forcing's
     const bool with_array = !force_zero_;
@@ -314,7 +325,7 @@ void FluidSolver::run_split_ffts_only() {
     const int dims[2] = {n, n};
     auto make = [&](unsigned fl) {
       fftw_plan_with_nthreads(1);
-      plan_split_r2c_ = fftw_plan_many_dft_r2c(2, dims, 3, f_[0], nullptr, 1, int(grid_.size()),
+      plan_split_r2c_ = fftw_plan_many_dft_r2c(2, dims, 3, f_[0], nullptr, 1, int(comp_r_),
                                                fh, nullptr, 1, int(n * plane_c_), fl);
       return plan_split_r2c_ != nullptr;
     };
@@ -393,7 +404,7 @@ void FluidSolver::run_ffts_only() {
   if (!plan_forward_) {
     // planned on first use, threaded like a textbook solver's, with the step's planner flags
     const int n = grid_.n;
-    const int nr = int(grid_.size());
+    const int nr = int(comp_r_);  // component stride
     const int nc = n * n * (n / 2 + 1);
     const int dims[3] = {n, n, n};
     auto* fh = reinterpret_cast<fftw_complex*>(fh_[0]);
@@ -424,13 +435,14 @@ double FluidSolver::kinetic_energy() const {
   // any thread count and any thread timing. (An OpenMP reduction(+) adds the threads' partial
   // sums in the order the threads finish, which changes the last bits from run to run with more
   // than two threads; a resumed run must reproduce every bit of the uninterrupted one.)
-  constexpr int kBlocks = 64;
-  const std::ptrdiff_t total = std::ptrdiff_t(3 * grid_.size());
-  const double* u = u_[0];
+  constexpr int kPerComp = 22, kBlocks = 3 * kPerComp;
+  const std::ptrdiff_t total = std::ptrdiff_t(grid_.size());  // per component
   double part[kBlocks];
 #pragma omp parallel for num_threads(threads_) schedule(static)
   for (int b = 0; b < kBlocks; ++b) {
-    const std::ptrdiff_t lo = total * b / kBlocks, hi = total * (b + 1) / kBlocks;
+    const double* u = u_[b / kPerComp];
+    const int bc = b % kPerComp;
+    const std::ptrdiff_t lo = total * bc / kPerComp, hi = total * (bc + 1) / kPerComp;
     double s = 0.0;
 #pragma omp simd reduction(+ : s)
     for (std::ptrdiff_t i = lo; i < hi; ++i) s += u[i] * u[i];

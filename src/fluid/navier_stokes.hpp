@@ -128,6 +128,8 @@ class FluidSolver {
   std::array<std::complex<double>*, 3> fh_{};  // r̂, then ûⁿ⁺¹, layout [x][y][k_z], x-stride
                                                //   plane_c_ ≥ n(n/2+1) (padded, see constructor)
   std::size_t plane_c_ = 0;
+  std::size_t comp_r_ = 0;  // component stride of u_ and f_, doubles (n³ + padding)
+  std::size_t comp_p_ = 0;  // component stride in a thread's plane buffer (n² + padding)
   double* plane_buf_ = nullptr;                // per thread: 3 real n×n planes of r
   bool force_zero_ = true;                     // f_ known to be all zero
   bool plan_measure_ = true;
