@@ -24,10 +24,10 @@ class Progress {
   /// Ends an in-place line (no-op otherwise).
   void finish_line();
 
-  /// Whether update() at now_s would print (lets callers skip formatting a line).
-  bool due(double now_s) const {
-    return out_ && (!printed_any_ || now_s - last_s_ >= interval_s_);
-  }
+  /// Whether one interval has passed since the last line (since time 0 before the first line):
+  /// a caller that prints its first line at a chosen moment still prints one after an interval
+  /// if that moment is late (a large grid's first output step).
+  bool due(double now_s) const { return out_ && now_s - last_s_ >= interval_s_; }
   /// Whether a progress line has been printed yet.
   bool started() const { return printed_any_; }
   bool tty() const { return tty_; }

@@ -718,8 +718,10 @@ RunResult run(const Config& c_user, const RunOptions& opt) {
         progress.update(progress_line(o), now, /*last=*/true);
         break;
       }
-      // the first line at the first output step, then by the clock (with the latest row)
-      if (progress.started() ? progress.due(now) : output_step)
+      // the first line at the first output step or after one interval, whichever comes first,
+      // then by the clock (with the latest row: ms/step and ETA are current, the observables are
+      // those of the last output step)
+      if ((output_step && !progress.started()) || progress.due(now))
         progress.update(progress_line(o), now);
     }
     r.reason = reason;

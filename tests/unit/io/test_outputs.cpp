@@ -192,6 +192,18 @@ TEST(Progress, PlainLinesAreThrottledToOnePerIntervalPlusFirstAndLast) {
   EXPECT_EQ(s.find('\r'), std::string::npos);
 }
 
+TEST(Progress, FirstLineIsDueAfterOneIntervalEvenWithoutAnOutputStep) {
+  // a 256³ run reaches its first output step after minutes: the log must not stay silent
+  Captured out;
+  io::Progress p(out.f, /*tty=*/0, /*interval_s=*/10.0);
+  EXPECT_FALSE(p.due(0.0));
+  EXPECT_FALSE(p.due(9.9));
+  EXPECT_TRUE(p.due(10.0));
+  p.update("first", 12.0);
+  EXPECT_FALSE(p.due(21.9));
+  EXPECT_TRUE(p.due(22.0));
+}
+
 TEST(Progress, TerminalLineIsRewrittenInPlace) {
   Captured out;
   {
