@@ -165,7 +165,10 @@ struct Captured {
   char* buf = nullptr;
   std::size_t size = 0;
   std::FILE* f = open_memstream(&buf, &size);
-  ~Captured() { std::free(buf); }
+  ~Captured() {
+    if (f) std::fclose(f);  // a test that read the text by fclose has set f to nullptr
+    std::free(buf);
+  }
   std::string text() {
     std::fflush(f);
     return std::string(buf, size);
