@@ -1,10 +1,7 @@
 // Debye–Hückel electrostatics between rod points, MODEL (2.19–2.22); Lim, Kim & Swigon 2011.
-#include <omp.h>
-
 #include <cmath>
 #include <numbers>
 
-#include "core/target_clones.hpp"
 #include "core/units.hpp"
 #include "interactions/cell_list.hpp"
 #include "interactions/interactions.hpp"
@@ -41,36 +38,6 @@ inline double pair(const DebyeHuckel& law, double e_shift, const Vec3& delta, do
   return e - e_shift;
 }
 
-// The direct sum's row i (partners j = i+1..n−1, positions x, y, z from j = i+1 on) in stages
-// whose loops vectorise: the squared distances and −κd; the exponentials (Eigen's vectorised
-// exp, in place); then the pair coefficients (A e^{−κd}/d)(1/d + κ)/d of −∂E/∂X (0 beyond the
-// cutoff) and the shifted energies. At low salt, where the cutoff exceeds the ring and every
-// pair is summed, one scalar exp per pair made the pair forces cost ~40 % of a 64³ step.
-IBROD_TARGET_CLONES void row_arguments(int m, double xi, double yi, double zi, const double* x,
-                                       const double* y, const double* z, double kappa,
-                                       double* d2, double* arg) {
-#pragma omp simd
-  for (int k = 0; k < m; ++k) {
-    const double dx = xi - x[k], dy = yi - y[k], dz = zi - z[k];
-    const double s = dx * dx + dy * dy + dz * dz;
-    d2[k] = s;
-    arg[k] = -kappa * std::sqrt(s);
-  }
-}
-
-// ex: the exponentials in, the pairs' shifted energies out (summed by the caller)
-IBROD_TARGET_CLONES void row_coefficients(int m, double A, double kappa, double rc2, double shift,
-                                          const double* d2, double* ex, double* coef) {
-#pragma omp simd
-  for (int k = 0; k < m; ++k) {
-    const double inv = 1.0 / std::sqrt(d2[k]);
-    const double ek = A * ex[k] * inv;            // A e^{−κd}/d
-    const double in = d2[k] <= rc2 ? 1.0 : 0.0;  // within the cutoff
-    coef[k] = in * (ek * (inv + kappa) * inv);
-    ex[k] = in * (ek - shift);
-  }
-}
-
 }  // namespace
 
 Electrostatics::Electrostatics(const ElectroParams& p, int n) : p_(p) {
@@ -78,46 +45,6 @@ Electrostatics::Electrostatics(const ElectroParams& p, int n) : p_(p) {
   cells_.order.reserve(n);
   cells_.cell.reserve(n);
   cells_.x.reserve(n);
-}
-
-double Electrostatics::accumulate_all_pairs(std::span<const Vec3> X, std::span<Vec3> F,
-                                            double rc2) {
-  const int n = int(X.size());
-  const int nt = std::max(1, omp_get_max_threads());
-  // positions by component (SoA), and per thread 3 rows of scratch
-  if (soa_.size() < 3 * std::size_t(n)) soa_.resize(3 * std::size_t(n));
-  if (row_.size() < 3 * std::size_t(n) * nt) row_.resize(3 * std::size_t(n) * nt);
-  double* x = soa_.data();
-  double *y = x + n, *z = y + n;
-  for (int i = 0; i < n; ++i) {
-    x[i] = X[i][0];
-    y[i] = X[i][1];
-    z[i] = X[i][2];
-  }
-  const DebyeHuckel law = p_.law;
-  const double shift = e_shift_;
-  double* rows = row_.data();
-  return detail::parallel_pairs(n, F, thread_F_, thread_E_, [&](int i, Vec3* Ft, double& E) {
-    const int m = n - i - 1;
-    if (m <= 0) return;
-    double* d2 = rows + 3 * std::size_t(n) * omp_get_thread_num();
-    double* ex = d2 + n;
-    double* coef = ex + n;
-    const int j0 = i + 1;
-    row_arguments(m, x[i], y[i], z[i], x + j0, y + j0, z + j0, law.kappa, d2, ex);
-    Eigen::Map<Eigen::ArrayXd> e(ex, m);
-    e = e.exp();
-    row_coefficients(m, law.A, law.kappa, rc2, shift, d2, ex, coef);
-    E += e.sum();
-    const Vec3 xi = X[i];
-    Vec3 fi = Vec3::Zero();
-    for (int k = 0; k < m; ++k) {
-      const Vec3 f = coef[k] * (xi - X[j0 + k]);
-      fi += f;
-      Ft[j0 + k] -= f;
-    }
-    Ft[i] += fi;
-  });
 }
 
 double Electrostatics::accumulate(std::span<const Vec3> X, std::span<Vec3> F) {
@@ -138,7 +65,23 @@ double Electrostatics::accumulate(std::span<const Vec3> X, std::span<Vec3> F) {
   }
   // The bodies copy what they read into locals: through the lambda's captured references the
   // compiler would have to reload them after every store into the force buffer (aliasing).
-  if (!used_cells_) return accumulate_all_pairs(X, F, rc2);
+  if (!used_cells_) {
+    return detail::parallel_pairs(n, F, thread_F_, thread_E_, [&](int i, Vec3* Ft, double& E) {
+      const DebyeHuckel lw = law;
+      const double r2 = rc2, sh = shift;
+      const Vec3* x = X.data();
+      const Vec3 xi = x[i];
+      Vec3 fi = Vec3::Zero();
+      double e = 0;
+      for (int j = i + 1; j < n; ++j) {
+        const Vec3 delta = xi - x[j];
+        const double d2 = delta.squaredNorm();
+        if (d2 <= r2) e += pair(lw, sh, delta, d2, fi, Ft[j]);
+      }
+      Ft[i] += fi;
+      E += e;
+    });
+  }
   detail::bin(g, X, cells_);
   const detail::CellScratch& c = cells_;
   return detail::parallel_pairs(n, F, thread_F_, thread_E_, [&](int a, Vec3* Ft, double& E) {

@@ -104,10 +104,6 @@ class Electrostatics {
   detail::CellScratch cells_;
   std::vector<Vec3> thread_F_;    ///< [threads × n] private force buffers
   std::vector<double> thread_E_;  ///< [threads] private energies
-  std::vector<double> soa_;       ///< [3 × n] positions by component (all-pairs sum)
-  std::vector<double> row_;       ///< [threads × 3 × n] one row's d², exponentials, coefficients
-  /// every pair i < j within rc2 (no cell list), row by row in vectorised stages
-  double accumulate_all_pairs(std::span<const Vec3> X, std::span<Vec3> F, double rc2);
 };
 
 /// Closest points of the segments P(s) = P0 + s(P1 − P0), Q(t) = Q0 + t(Q1 − Q0), s, t ∈ [0,1].
