@@ -320,8 +320,8 @@ void FluidSolver::run_split_ffts_only() {
   const std::size_t np = std::size_t(n) * n;
   fftw_complex* fh = reinterpret_cast<fftw_complex*>(fh_[0]);
   if (!plan_split_r2c_) {
-    // the step's plane r2c reads its three components n² apart (the plane buffer); here they
-    // are n³ apart (the force array): the same transform with another input stride
+    // the step's plane r2c reads its three components comp_p_ apart (the plane buffer); here
+    // they are comp_r_ apart (the force array): the same transform with another input stride
     const int dims[2] = {n, n};
     auto make = [&](unsigned fl) {
       fftw_plan_with_nthreads(1);
