@@ -19,17 +19,17 @@
 #include "cmd_analysis.hpp"
 #include "cmd_sweep.hpp"
 #include "exit_status.hpp"
-#include "io/bench.hpp"
-#include "io/config.hpp"
-#include "io/mpi_env.hpp"
-#include "io/run.hpp"
+#include "driver/bench.hpp"
+#include "config/config.hpp"
+#include "driver/mpi_env.hpp"
+#include "driver/run.hpp"
 
 namespace {
 
-ibrod::io::Config resolve(const std::string& path, const std::vector<std::string>& sets) {
-  ibrod::io::Config c = ibrod::io::load_config(path);
-  for (const auto& s : sets) ibrod::io::apply_override(c, s);
-  ibrod::io::validate(c);
+ibrod::config::Config resolve(const std::string& path, const std::vector<std::string>& sets) {
+  ibrod::config::Config c = ibrod::config::load_config(path);
+  for (const auto& s : sets) ibrod::config::apply_override(c, s);
+  ibrod::config::validate(c);
   return c;
 }
 
@@ -92,13 +92,13 @@ int main(int argc, char** argv) {
   // `mpirun -np K ibrod run`: MPI is initialised (only under a launcher) before anything can
   // fail, so that every rank reaches the same error and exit status; K > 1 splits the fluid grid
   // over the ranks (io/run.hpp). Without a launcher this is a one-process program, MPI untouched.
-  ibrod::io::mpi::World world;
-  if (*run) world = ibrod::io::mpi::init(&argc, &argv);
+  ibrod::driver::mpi::World world;
+  if (*run) world = ibrod::driver::mpi::init(&argc, &argv);
   struct Finalize {
-    const ibrod::io::mpi::World& w;
+    const ibrod::driver::mpi::World& w;
     ~Finalize() {
       std::fflush(stdout);
-      ibrod::io::mpi::finalize(w);
+      ibrod::driver::mpi::finalize(w);
     }
   } finalize{world};
 
@@ -113,19 +113,19 @@ int main(int argc, char** argv) {
       throw ibrod::ConfigError("resume: '" + resume_dir +
                                "' holds no config.toml: it is not the output directory of an "
                                "ibrod run");
-    const ibrod::io::Config c = resolve(config_path, sets);
+    const ibrod::config::Config c = resolve(config_path, sets);
     if (*check) {
       std::printf("# resolved configuration\n%s\n# derived quantities\n%s",
-                  ibrod::io::describe(c).c_str(), ibrod::io::derived_report(c).c_str());
+                  ibrod::config::describe(c).c_str(), ibrod::config::derived_report(c).c_str());
       return 0;
     }
     if (*bench) {
-      ibrod::io::Config b = c;
+      ibrod::config::Config b = c;
       if (bench_threads > 0) b.run_threads = bench_threads;
-      ibrod::io::print_bench(b, ibrod::io::bench(b, bench_steps), stdout);
+      ibrod::driver::print_bench(b, ibrod::driver::bench(b, bench_steps), stdout);
       return 0;
     }
-    ibrod::io::RunOptions opt;
+    ibrod::driver::RunOptions opt;
     opt.output_dir = out_dir;
     opt.overwrite = overwrite;
     opt.resume = resuming;
@@ -133,7 +133,7 @@ int main(int argc, char** argv) {
     opt.fftw_wisdom = wisdom;
     opt.rank = world.rank;
     opt.ranks = world.size;
-    const ibrod::io::RunResult r = ibrod::io::run(c, opt);
+    const ibrod::driver::RunResult r = ibrod::driver::run(c, opt);
     if (r.signal != 0 && world.rank == 0) {
       std::fprintf(stderr,
                    "ibrod: stopped by signal %d at step %lld; checkpoint written. Continue with: "

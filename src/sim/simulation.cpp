@@ -65,11 +65,4 @@ StopReason Simulation::stop_reason(const Observables& o) const {
   return StopReason::none;
 }
 
-bool Simulation::finite() const {
-  for (int k = 0; k < rod_.size(); ++k)
-    if (!rod_.X[k].allFinite() || !rod_.D[k].allFinite()) return false;
-  // a NaN or Inf anywhere in the fluid makes the kinetic energy non-finite
-  return std::isfinite(stepper_.fluid_kinetic_energy());
-}
-
 }  // namespace ibrod::sim

@@ -53,13 +53,11 @@ class Simulation {
   /// One time step.
   void step();
   /// Diagnostics of the current state (O(n²) writhe and closest approach: output steps only).
-  /// With a distributed fluid every rank must call step(), observe() and finite() alike (the
-  /// kinetic energy is summed over the ranks).
+  /// With a distributed fluid every rank must call step() and observe() alike (the kinetic
+  /// energy is summed over the ranks).
   Observables observe();
   /// Stop rule, checked at output steps: t ≥ t_end, or E_K below the threshold (after step 0).
   StopReason stop_reason(const Observables& o) const;
-  /// true if every position, triad and fluid velocity is finite
-  bool finite() const;
 
  private:
   SimParams p_;

@@ -26,9 +26,9 @@
 #include <utility>
 #include <vector>
 
-#include "io/config.hpp"
+#include "config/config.hpp"
 
-namespace ibrod::io {
+namespace ibrod::driver {
 
 struct SweepAxis {
   std::string key;                  ///< config path, "rod.excess_link"
@@ -41,7 +41,7 @@ struct SweepPoint {
   std::size_t index = 0;  ///< position in the product (first axis slowest)
   std::string name;       ///< directory name: "dlk=4_salt_M=0.1"
   std::vector<std::pair<std::string, std::string>> assignments;  ///< key → TOML value text
-  Config config;          ///< resolved and validated
+  config::Config config;          ///< resolved and validated
 };
 
 struct Sweep {
@@ -105,4 +105,4 @@ SweepReport run_sweep(const Sweep& sweep, const SweepOptions& opt);
 /// points.csv: index,name,<keys> (header and one row per point).
 std::string points_csv(const Sweep& sweep);
 
-}  // namespace ibrod::io
+}  // namespace ibrod::driver

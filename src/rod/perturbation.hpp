@@ -10,7 +10,7 @@
 #include <cstdint>
 #include <vector>
 
-namespace ibrod::io {
+namespace ibrod::rod {
 
 /// rod.perturbation_random = { modes = M, amplitude = A, seed = S }; M = 0 or A = 0: none.
 struct RandomPerturbation {
@@ -28,4 +28,4 @@ std::vector<double> draw_perturbation(const RandomPerturbation& r);
 std::vector<double> combined_perturbation(const std::vector<double>& deterministic,
                                           const RandomPerturbation& r);
 
-}  // namespace ibrod::io
+}  // namespace ibrod::rod

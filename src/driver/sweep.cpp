@@ -1,4 +1,4 @@
-#include "io/sweep.hpp"
+#include "driver/sweep.hpp"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -25,7 +25,10 @@
 
 extern char** environ;
 
-namespace ibrod::io {
+namespace ibrod::driver {
+
+using namespace ibrod::config;
+using namespace ibrod::io;
 
 namespace fs = std::filesystem;
 
@@ -630,4 +633,4 @@ SweepReport run_sweep(const Sweep& sw, const SweepOptions& opt) {
   return rep;
 }
 
-}  // namespace ibrod::io
+}  // namespace ibrod::driver

@@ -18,10 +18,10 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.hpp"
-#include "io/analyze.hpp"
+#include "analysis/analyze.hpp"
 #include "render/image.hpp"
 
-namespace ibrod::io {
+namespace ibrod::analysis {
 namespace {
 
 namespace fs = std::filesystem;
@@ -226,4 +226,4 @@ TEST(RenderRun, FinalStateFromCsvIntoNamedFiles) {
 }
 
 }  // namespace
-}  // namespace ibrod::io
+}  // namespace ibrod::analysis

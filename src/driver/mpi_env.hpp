@@ -5,7 +5,7 @@
 // Without IBROD_MPI every function here is the one-rank answer.
 #include <string>
 
-namespace ibrod::io::mpi {
+namespace ibrod::driver::mpi {
 
 /// true if built with MPI (IBROD_MPI).
 bool available();
@@ -33,4 +33,4 @@ std::string broadcast(const std::string& s);
 /// MPI_Finalize if init() initialised MPI.
 void finalize(const World& w);
 
-}  // namespace ibrod::io::mpi
+}  // namespace ibrod::driver::mpi

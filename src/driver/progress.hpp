@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <string>
 
-namespace ibrod::io {
+namespace ibrod::driver {
 
 class Progress {
  public:
@@ -42,4 +42,4 @@ class Progress {
   std::size_t last_width_ = 0;
 };
 
-}  // namespace ibrod::io
+}  // namespace ibrod::driver

@@ -1,8 +1,9 @@
-#include "io/progress.hpp"
+#include "driver/progress.hpp"
 
 #include <unistd.h>
 
-namespace ibrod::io {
+namespace ibrod::driver {
+
 
 Progress::Progress(std::FILE* out, int tty, double interval_s, double tty_interval_s)
     : out_(out),
@@ -46,4 +47,4 @@ void Progress::finish_line() {
   last_width_ = 0;
 }
 
-}  // namespace ibrod::io
+}  // namespace ibrod::driver

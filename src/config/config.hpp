@@ -7,10 +7,10 @@
 #include <string>
 #include <vector>
 
-#include "io/perturbation.hpp"
+#include "rod/perturbation.hpp"
 #include "sim/simulation.hpp"
 
-namespace ibrod::io {
+namespace ibrod::config {
 
 struct Config {
   // [grid]
@@ -25,7 +25,7 @@ struct Config {
   int rod_base_pairs = 600;        ///< rod.base_pairs: rod points n
   int rod_excess_link = 6;         ///< rod.excess_link: ΔLk (integer)
   std::vector<double> rod_perturbation{1.0};  ///< rod.perturbation: ε_m, m = 1, 2, …, rad
-  RandomPerturbation rod_perturbation_random;  ///< rod.perturbation_random: drawn ε_m, added
+  rod::RandomPerturbation rod_perturbation_random;  ///< rod.perturbation_random: drawn ε_m, added
   double rod_rise_A = 3.4;         ///< rod.rise_A: Δs, Å
   double rod_bend_modulus_erg_cm = 1.3e-19;   ///< a1 = a2, erg·cm
   double rod_twist_modulus_erg_cm = 1.82e-19; ///< a3, erg·cm
@@ -85,4 +85,4 @@ sim::SimParams to_params(const Config& c);
 /// Derived quantities for `ibrod check`: h, c, Δs, r0, 1/κ, Bjerrum length, steps, memory.
 std::string derived_report(const Config& c);
 
-}  // namespace ibrod::io
+}  // namespace ibrod::config

@@ -1,4 +1,4 @@
-#include "io/run.hpp"
+#include "driver/run.hpp"
 
 #include <algorithm>
 #include <array>
@@ -21,47 +21,19 @@
 #include "io/atomic_file.hpp"
 #include "io/checkpoint.hpp"
 #include "io/h5md.hpp"
-#include "io/mpi_env.hpp"
+#include "driver/mpi_env.hpp"
 #include "io/npy.hpp"
-#include "io/progress.hpp"
+#include "driver/progress.hpp"
+#include "sim/rod_problem.hpp"
 #include "io/vtk.hpp"
 
-namespace ibrod::io {
+namespace ibrod::driver {
+
+using namespace ibrod::config;
+using namespace ibrod::io;
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
-
-std::string rod_problem(const rod::RodState& s, double ds) {
-  const int n = s.size();
-  char buf[256];
-  for (int k = 0; k < n; ++k) {
-    if (!s.X[k].allFinite()) {
-      std::snprintf(buf, sizeof buf, "the position of point %d is not finite (%g, %g, %g) Å", k,
-                    s.X[k][0], s.X[k][1], s.X[k][2]);
-      return buf;
-    }
-    if (!s.D[k].allFinite()) return "the triad of point " + std::to_string(k) + " is not finite";
-  }
-  for (int k = 0; k < n; ++k) {
-    const int k1 = k + 1 == n ? 0 : k + 1;
-    const double r = (s.X[k1] - s.X[k]).norm() / ds;
-    if (!(r >= 0.5 && r <= 1.5)) {
-      std::snprintf(buf, sizeof buf,
-                    "the spacing of points %d and %d is %.4g Δs (allowed: 0.5 to 1.5 Δs)", k, k1, r);
-      return buf;
-    }
-  }
-  for (int k = 0; k < n; ++k) {
-    const double e = (s.D[k].transpose() * s.D[k] - Mat3::Identity()).cwiseAbs().maxCoeff();
-    if (!(e <= 1e-3)) {
-      std::snprintf(buf, sizeof buf,
-                    "the triad of point %d is off orthonormal by %.3g (max |DᵀD − I|; allowed 1e-3)",
-                    k, e);
-      return buf;
-    }
-  }
-  return {};
-}
 
 namespace {
 
@@ -667,7 +639,7 @@ RunResult run(const Config& c_user, const RunOptions& opt) {
   try {
     ensure_space(reserve_bytes);
     if (r.resumed_from < 0) {
-      if (const std::string bad = rod_problem(sim.rod(), c.rod_rise_A); !bad.empty())
+      if (const std::string bad = sim::rod_problem(sim.rod(), c.rod_rise_A); !bad.empty())
         blow_up("the initial state is not sane: " + bad);
       o = observe_checked();
       r.initial = meta.initial = o;
@@ -695,7 +667,7 @@ RunResult run(const Config& c_user, const RunOptions& opt) {
         return r;
       }
       sim.step();
-      if (const std::string bad = rod_problem(sim.rod(), c.rod_rise_A); !bad.empty()) blow_up(bad);
+      if (const std::string bad = sim::rod_problem(sim.rod(), c.rod_rise_A); !bad.empty()) blow_up(bad);
       const std::int64_t step = sim.step_count();
       const bool at_end = step >= total_steps;
       const bool output_step = step % every == 0 || at_end;
@@ -749,4 +721,4 @@ RunResult run(const Config& c_user, const RunOptions& opt) {
   return r;
 }
 
-}  // namespace ibrod::io
+}  // namespace ibrod::driver

@@ -15,7 +15,7 @@
 #include "core/types.hpp"
 #include "diagnostics/relaxation.hpp"
 
-namespace ibrod::io {
+namespace ibrod::analysis {
 
 /// A CSV file with a header row and numeric fields, by column.
 struct CsvTable {
@@ -137,4 +137,4 @@ void parse_size(const std::string& text, int& width, int& height);
 std::vector<std::filesystem::path> render_run(const std::filesystem::path& dir,
                                               const RenderOptions& opt, std::FILE* log = stdout);
 
-}  // namespace ibrod::io
+}  // namespace ibrod::analysis

@@ -5,9 +5,9 @@
 #include <string>
 #include <vector>
 
-#include "io/config.hpp"
+#include "config/config.hpp"
 
-namespace ibrod::io {
+namespace ibrod::driver {
 
 struct BenchPhase {
   std::string name;
@@ -31,8 +31,8 @@ struct BenchResult {
 /// Runs about 2 × `steps` steps (after a short warm-up) from the configured initial state, in
 /// interleaved rounds of whole steps, phase-timed steps and FFTs alone; each figure is the
 /// minimum over the rounds of its per-round mean.
-BenchResult bench(const Config& c, int steps);
+BenchResult bench(const config::Config& c, int steps);
 /// Prints the table; the last line is `ratio_step_to_fft=<value>`.
-void print_bench(const Config& c, const BenchResult& r, std::FILE* out);
+void print_bench(const config::Config& c, const BenchResult& r, std::FILE* out);
 
-}  // namespace ibrod::io
+}  // namespace ibrod::driver

@@ -1,9 +1,9 @@
-#include "io/perturbation.hpp"
+#include "rod/perturbation.hpp"
 
 #include <algorithm>
 #include <random>
 
-namespace ibrod::io {
+namespace ibrod::rod {
 
 std::vector<double> draw_perturbation(const RandomPerturbation& r) {
   std::vector<double> eps;
@@ -27,4 +27,4 @@ std::vector<double> combined_perturbation(const std::vector<double>& determinist
   return eps;
 }
 
-}  // namespace ibrod::io
+}  // namespace ibrod::rod

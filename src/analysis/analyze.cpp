@@ -1,5 +1,5 @@
 // `ibrod analyze` and `ibrod render` on a run directory (analyze.hpp).
-#include "io/analyze.hpp"
+#include "analysis/analyze.hpp"
 
 #include <nlohmann/json.hpp>
 #include <toml++/toml.h>
@@ -18,7 +18,9 @@
 #include "render/image.hpp"
 #include "render/render.hpp"
 
-namespace ibrod::io {
+namespace ibrod::analysis {
+
+using namespace ibrod::io;
 
 namespace fs = std::filesystem;
 using json = nlohmann::ordered_json;
@@ -419,4 +421,4 @@ std::vector<fs::path> render_run(const fs::path& dir, const RenderOptions& opt, 
   return written;
 }
 
-}  // namespace ibrod::io
+}  // namespace ibrod::analysis

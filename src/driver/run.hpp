@@ -19,11 +19,11 @@
 #include <cstdio>
 #include <string>
 
-#include "io/config.hpp"
+#include "config/config.hpp"
 #include "io/observables.hpp"
 #include "sim/simulation.hpp"
 
-namespace ibrod::io {
+namespace ibrod::driver {
 
 struct RunOptions {
   std::string output_dir = "ibrod-out";
@@ -63,10 +63,6 @@ inline constexpr double kLinkDriftWarning = 0.1;
 /// Run (or, with opt.resume, continue) one trajectory. Throws ConfigError (bad config, output
 /// directory exists, unusable checkpoint) or RunError (blow-up, I/O failure: disk full, …).
 /// A SIGINT/SIGTERM does not throw: the result has signal set.
-RunResult run(const Config& c, const RunOptions& opt);
+RunResult run(const config::Config& c, const RunOptions& opt);
 
-/// Empty if the rod is sane; otherwise what is wrong, naming the point: a non-finite position or
-/// triad, an adjacent spacing off Δs by more than 50 %, a triad off orthonormal by more than 1e-3.
-std::string rod_problem(const rod::RodState& s, double ds);
-
-}  // namespace ibrod::io
+}  // namespace ibrod::driver

@@ -1,4 +1,4 @@
-#include "io/config.hpp"
+#include "config/config.hpp"
 
 #include <cmath>
 #include <fstream>
@@ -13,7 +13,11 @@
 #include "core/units.hpp"
 #include "interactions/interactions.hpp"
 
-namespace ibrod::io {
+namespace ibrod::config {
+
+using rod::combined_perturbation;
+using rod::draw_perturbation;
+using rod::RandomPerturbation;
 
 Config::Config()
     : electrostatics_cutoff_debye(interactions::kDefaultCutoffDebye),
@@ -519,4 +523,4 @@ std::string derived_report(const Config& c) {
   return os.str();
 }
 
-}  // namespace ibrod::io
+}  // namespace ibrod::config

@@ -1,4 +1,4 @@
-#include "io/mpi_env.hpp"
+#include "driver/mpi_env.hpp"
 
 #include <cstdlib>
 
@@ -6,7 +6,8 @@
 #include <mpi.h>
 #endif
 
-namespace ibrod::io::mpi {
+namespace ibrod::driver::mpi {
+
 
 bool available() {
 #ifdef IBROD_MPI
@@ -93,4 +94,4 @@ void finalize([[maybe_unused]] const World& w) {
 #endif
 }
 
-}  // namespace ibrod::io::mpi
+}  // namespace ibrod::driver::mpi

@@ -7,7 +7,7 @@
 #include <fstream>
 
 #include "core/error.hpp"
-#include "io/sweep.hpp"
+#include "driver/sweep.hpp"
 
 using namespace ibrod;
 using ::testing::HasSubstr;
@@ -19,8 +19,8 @@ const char* kTiny =
     "[grid]\nn = 16\nbox_A = 200.0\n[rod]\nbase_pairs = 100\n[time]\nt_end_us = 0.02\n"
     "[run]\nfftw_measure = false\n";
 
-io::Sweep parse(const std::string& text, const fs::path& dir = fs::temp_directory_path()) {
-  return io::parse_sweep(text, "test.toml", dir);
+driver::Sweep parse(const std::string& text, const fs::path& dir = fs::temp_directory_path()) {
+  return driver::parse_sweep(text, "test.toml", dir);
 }
 
 std::string error_of(const std::string& text, const fs::path& dir = fs::temp_directory_path()) {
@@ -52,18 +52,18 @@ TEST(Sweep, IsTheProductWithTheFirstKeySlowestAndStableNames) {
   EXPECT_EQ(parse(std::string(kTiny) + "[sweep]\n\"rod.excess_link\" = [1, 2, 3]\n"
                                        "solvent.salt_M = [0.01, 0.1]\n").points[5].name,
             "dlk=3_salt_M=0.1");
-  EXPECT_THAT(io::points_csv(sw), HasSubstr("index,name,rod.excess_link,solvent.salt_M\n"
+  EXPECT_THAT(driver::points_csv(sw), HasSubstr("index,name,rod.excess_link,solvent.salt_M\n"
                                             "0,dlk=1_salt_M=0.01,1,0.01\n"));
 }
 
 TEST(Sweep, NamesAreSanitisedShortenedAndRenamable) {
-  EXPECT_EQ(io::sanitize_name("a/b c*d"), "a-b-c-d");
-  EXPECT_EQ(io::sanitize_name("..x"), "_..x");
-  EXPECT_EQ(io::sanitize_name(""), "_");
+  EXPECT_EQ(driver::sanitize_name("a/b c*d"), "a-b-c-d");
+  EXPECT_EQ(driver::sanitize_name("..x"), "_..x");
+  EXPECT_EQ(driver::sanitize_name(""), "_");
   const std::string longer(300, 'x');
-  EXPECT_EQ(io::sanitize_name(longer).size(), 197u);
-  EXPECT_EQ(io::sanitize_name(longer), io::sanitize_name(longer));
-  EXPECT_NE(io::sanitize_name(longer), io::sanitize_name(longer + "y"));
+  EXPECT_EQ(driver::sanitize_name(longer).size(), 197u);
+  EXPECT_EQ(driver::sanitize_name(longer), driver::sanitize_name(longer));
+  EXPECT_NE(driver::sanitize_name(longer), driver::sanitize_name(longer + "y"));
 
   const auto sw = parse(std::string(kTiny) +
                         "[names]\n\"solvent.salt_M\" = \"cs\"\n"
@@ -121,33 +121,33 @@ TEST(Sweep, BadSweepFilesAreRejectedNamingTheKey) {
 TEST(Sweep, PointStatesFollowTheRunFiles) {
   const fs::path d = fs::temp_directory_path() / "ibrod_test_sweep_state";
   fs::remove_all(d);
-  EXPECT_EQ(io::point_state(d), io::PointState::fresh);
+  EXPECT_EQ(driver::point_state(d), driver::PointState::fresh);
   fs::create_directories(d);
-  EXPECT_EQ(io::point_state(d), io::PointState::fresh);
+  EXPECT_EQ(driver::point_state(d), driver::PointState::fresh);
   std::ofstream(d / "config.toml") << "x";
-  EXPECT_EQ(io::point_state(d), io::PointState::restart);
+  EXPECT_EQ(driver::point_state(d), driver::PointState::restart);
   std::ofstream(d / "checkpoint.bin") << "x";
-  EXPECT_EQ(io::point_state(d), io::PointState::interrupted);
+  EXPECT_EQ(driver::point_state(d), driver::PointState::interrupted);
   std::ofstream(d / "summary.json") << "{\"stop_reason\": \"interrupted\"}";
-  EXPECT_EQ(io::point_state(d), io::PointState::interrupted);
+  EXPECT_EQ(driver::point_state(d), driver::PointState::interrupted);
   std::ofstream(d / "summary.json") << "{\"stop_reason\": \"end_time\"}";
-  EXPECT_EQ(io::point_state(d), io::PointState::finished);
+  EXPECT_EQ(driver::point_state(d), driver::PointState::finished);
   std::ofstream(d / "summary.json") << "{\"stop_reason\": \"equilibrium\"}";
-  EXPECT_EQ(io::point_state(d), io::PointState::finished);
+  EXPECT_EQ(driver::point_state(d), driver::PointState::finished);
   std::ofstream(d / "summary.json") << "{\"stop_reason\": \"blow_up\"}";
-  EXPECT_EQ(io::point_state(d), io::PointState::failed);
+  EXPECT_EQ(driver::point_state(d), driver::PointState::failed);
   fs::remove_all(d);
 }
 
 TEST(Sweep, TheReferenceExampleIsTheEighteenReferenceRuns) {
-  const auto sw = io::load_sweep(fs::path(IBROD_SOURCE_DIR) / "examples" / "sweep_reference.toml");
+  const auto sw = driver::load_sweep(fs::path(IBROD_SOURCE_DIR) / "examples" / "sweep_reference.toml");
   ASSERT_EQ(sw.points.size(), 18u);
   // each point's config equals examples/reference/dlkN_csC.toml
   for (const auto& pt : sw.points) {
     char name[64];
     std::snprintf(name, sizeof name, "dlk%d_cs%g.toml", pt.config.rod_excess_link,
                   pt.config.solvent_salt_M);
-    const auto ref = io::load_config((fs::path(IBROD_SOURCE_DIR) / "examples" / "reference" / name).string());
-    EXPECT_EQ(io::to_toml(pt.config), io::to_toml(ref)) << pt.name;
+    const auto ref = config::load_config((fs::path(IBROD_SOURCE_DIR) / "examples" / "reference" / name).string());
+    EXPECT_EQ(config::to_toml(pt.config), config::to_toml(ref)) << pt.name;
   }
 }

@@ -1,4 +1,4 @@
-#include "io/bench.hpp"
+#include "driver/bench.hpp"
 
 #include <omp.h>
 
@@ -8,7 +8,9 @@
 
 #include "sim/simulation.hpp"
 
-namespace ibrod::io {
+namespace ibrod::driver {
+
+using namespace ibrod::config;
 
 namespace {
 
@@ -163,4 +165,4 @@ void print_bench(const Config& c, const BenchResult& r, std::FILE* out) {
   std::fprintf(out, "ratio_step_to_fft=%.4f\n", r.ratio());
 }
 
-}  // namespace ibrod::io
+}  // namespace ibrod::driver
