@@ -24,7 +24,8 @@
 #include "core/grid.hpp"
 #include "fluid/distributed_fluid.hpp"
 #include "fluid/navier_stokes.hpp"
-#include "ib/coupling.hpp"
+#include "ib/coupler.hpp"
+#include "ib/plane_coupler.hpp"
 #include "interactions/interactions.hpp"
 #include "rod/rod.hpp"
 
