@@ -44,8 +44,7 @@ struct StepperParams {
   bool distributed = false;
 };
 
-/// Potential energies at the force evaluation of the latest step (the state before the move),
-/// g Å² s⁻².
+/// Potential energies of the state whose forces compute_forces() evaluated, g Å² s⁻².
 struct StepEnergies {
   rod::ElasticEnergy elastic;
   double electro = 0;
