@@ -13,7 +13,7 @@
 #include "diagnostics/topology.hpp"
 #include "fluid/advection.hpp"
 #include "fluid/navier_stokes.hpp"
-#include "ib/coupling.hpp"
+#include "ib/plane_coupler.hpp"
 #include "interactions/interactions.hpp"
 #include "config/config.hpp"
 #include "rod/rod.hpp"

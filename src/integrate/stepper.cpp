@@ -45,7 +45,7 @@ Stepper::Stepper(const StepperParams& p)
   T_.resize(n);
   U_.resize(n);
   W_.resize(n);
-  if (dist_) UW_.resize(6 * std::size_t(n));
+  if (dist_) rank_sum_.resize(6 * std::size_t(n));
 }
 
 Stepper::~Stepper() = default;
@@ -71,7 +71,7 @@ StepEnergies Stepper::compute_forces(const rod::RodState& s) {
 }
 
 void Stepper::step(rod::RodState& s) {
-  last_ = compute_forces(s);
+  compute_forces(s);
   if (dist_) {
     // the same step on this rank's x-slab; U, W are partial sums until summed over the ranks
     dist_->begin_step();
@@ -82,14 +82,14 @@ void Stepper::step(rod::RodState& s) {
     const std::size_t n = U_.size();
     for (std::size_t k = 0; k < n; ++k)
       for (int d = 0; d < 3; ++d) {
-        UW_[3 * k + d] = U_[k][d];
-        UW_[3 * (n + k) + d] = W_[k][d];
+        rank_sum_[3 * k + d] = U_[k][d];
+        rank_sum_[3 * (n + k) + d] = W_[k][d];
       }
-    dist_->sum_over_ranks(UW_.data(), UW_.size());
+    dist_->sum_over_ranks(rank_sum_.data(), rank_sum_.size());
     for (std::size_t k = 0; k < n; ++k)
       for (int d = 0; d < 3; ++d) {
-        U_[k][d] = UW_[3 * k + d];
-        W_[k][d] = UW_[3 * (n + k) + d];
+        U_[k][d] = rank_sum_[3 * k + d];
+        W_[k][d] = rank_sum_[3 * (n + k) + d];
       }
     rod::advance(s, U_, W_, p_.fluid.dt);
     return;

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "core/error.hpp"
-#include "ib/coupling.hpp"
+#include "ib/coupler.hpp"
 
 namespace ibrod::ib {
 namespace {
