@@ -13,6 +13,8 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/text_file.hpp"
+#include "config/toml_error.hpp"
 #include "io/atomic_file.hpp"
 #include "io/h5md.hpp"
 #include "render/image.hpp"
@@ -26,32 +28,6 @@ namespace fs = std::filesystem;
 using json = nlohmann::ordered_json;
 
 namespace {
-
-std::vector<std::string> split(const std::string& line, char sep) {
-  std::vector<std::string> out;
-  std::string field;
-  std::istringstream in(line);
-  while (std::getline(in, field, sep)) out.push_back(field);
-  if (!line.empty() && line.back() == sep) out.emplace_back();
-  return out;
-}
-
-bool parse_double(const std::string& s, double& v) {
-  if (s.empty()) return false;
-  char* end = nullptr;
-  errno = 0;
-  v = std::strtod(s.c_str(), &end);
-  while (end && (*end == ' ' || *end == '\r')) ++end;
-  return end && *end == '\0' && s.c_str() != end;
-}
-
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  if (!in) throw ConfigError("cannot read '" + p.string() + "'");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 FitWindow fit_window(const diag::LineFit& f, std::span<const double> t, double tolerance) {
   return {t[f.first], t[f.first + f.count - 1], f.count, f.r2, f.max_abs_residual,
@@ -78,58 +54,13 @@ std::string time_label(double t_us) {
 
 }  // namespace
 
-// ---- CSV and config
-
-bool CsvTable::has(const std::string& name) const {
-  return std::find(names.begin(), names.end(), name) != names.end();
-}
-
-std::span<const double> CsvTable::column(const std::string& name) const {
-  const auto it = std::find(names.begin(), names.end(), name);
-  if (it == names.end())
-    throw ConfigError("'" + path.string() + "' has no column '" + name + "'");
-  return columns[std::size_t(it - names.begin())];
-}
-
-CsvTable read_csv_table(const fs::path& path) {
-  const std::string text = read_text(path);
-  CsvTable t;
-  t.path = path;
-  std::istringstream in(text);
-  std::string line;
-  if (!std::getline(in, line)) throw ConfigError("'" + path.string() + "' is empty");
-  if (!line.empty() && line.back() == '\r') line.pop_back();
-  t.names = split(line, ',');
-  t.columns.assign(t.names.size(), {});
-  const bool ends_in_newline = !text.empty() && text.back() == '\n';
-  std::size_t lineno = 1;
-  while (std::getline(in, line)) {
-    ++lineno;
-    if (line.empty() || line == "\r") continue;
-    const auto fields = split(line, ',');
-    std::vector<double> v(fields.size());
-    bool ok = fields.size() == t.names.size();
-    for (std::size_t k = 0; ok && k < fields.size(); ++k) ok = parse_double(fields[k], v[k]);
-    if (!ok) {
-      if (in.peek() == EOF && !ends_in_newline) break;  // a row cut short by a killed run
-      throw ConfigError("'" + path.string() + "' line " + std::to_string(lineno) + ": expected " +
-                        std::to_string(t.names.size()) + " numbers, got '" + line + "'");
-    }
-    for (std::size_t k = 0; k < v.size(); ++k) t.columns[k].push_back(v[k]);
-  }
-  return t;
-}
+// ---- config
 
 RunInfo read_run_info(const fs::path& dir) {
   RunInfo info;
   const fs::path p = dir / "config.toml";
   if (!fs::exists(p)) return info;
-  toml::table tbl;
-  try {
-    tbl = toml::parse(read_text(p), p.string());
-  } catch (const toml::parse_error& e) {
-    throw ConfigError("'" + p.string() + "' is not valid TOML: " + std::string(e.description()));
-  }
+  const toml::table tbl = config::parse_toml(read_text_file(p, "analyze"), p.string(), "analyze");
   info.diameter_A = tbl["steric"]["diameter_A"].value<double>().value_or(info.diameter_A);
   info.excess_link = tbl["rod"]["excess_link"].value<int>().value_or(info.excess_link);
   info.salt_M = tbl["solvent"]["salt_M"].value<double>().value_or(info.salt_M);
@@ -250,7 +181,7 @@ Analysis analyze_run(const fs::path& dir, const AnalyzeOptions& opt) {
   json summary = json::object();
   if (fs::exists(sp)) {
     try {
-      summary = json::parse(read_text(sp));
+      summary = json::parse(read_text_file(sp, "analyze"));
     } catch (const json::parse_error& e) {
       throw ConfigError("'" + sp.string() + "' is not valid JSON: " + e.what());
     }
@@ -279,7 +210,7 @@ RodFrame read_final_state(const fs::path& dir) {
   const fs::path sp = dir / "summary.json";
   if (fs::exists(sp)) {
     try {
-      const auto j = nlohmann::json::parse(read_text(sp));
+      const auto j = nlohmann::json::parse(read_text_file(sp, "analyze"));
       if (j.contains("time_us") && j["time_us"].is_number()) f.time_us = j["time_us"].get<double>();
       if (j.contains("steps") && j["steps"].is_number_integer()) f.step = j["steps"].get<std::int64_t>();
     } catch (const nlohmann::json::exception&) {
@@ -376,7 +307,7 @@ std::vector<fs::path> render_run(const fs::path& dir, const RenderOptions& opt, 
     double v = 0;
     if (s == "final") {
       want_final = true;
-    } else if (parse_double(s, v) && std::isfinite(v) && v >= 0) {
+    } else if (io::parse_double(s, v) && std::isfinite(v) && v >= 0) {
       times.push_back(v);
     } else {
       throw ConfigError("--time '" + s + "': expected a time in µs (≥ 0) or 'final'");

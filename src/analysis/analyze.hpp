@@ -14,25 +14,12 @@
 
 #include "core/types.hpp"
 #include "diagnostics/relaxation.hpp"
+#include "io/csv.hpp"
 
 namespace ibrod::analysis {
 
-/// A CSV file with a header row and numeric fields, by column.
-struct CsvTable {
-  std::filesystem::path path;
-  std::vector<std::string> names;
-  std::vector<std::vector<double>> columns;  ///< [names.size()][rows]
-
-  std::size_t rows() const { return columns.empty() ? 0 : columns.front().size(); }
-  bool has(const std::string& name) const;
-  /// The column called `name`; ConfigError naming the file if there is none.
-  std::span<const double> column(const std::string& name) const;
-};
-
-/// Reads a CSV file of numbers with a header row (timeseries.csv, final_state.csv). A final line
-/// cut short (a run killed while writing it) is dropped; any other malformed line throws
-/// ConfigError naming the file and line.
-CsvTable read_csv_table(const std::filesystem::path& path);
+using io::CsvTable;
+using io::read_csv_table;
 
 /// The keys of config.toml that post-processing needs (read leniently: other keys are ignored,
 /// so directories written by other versions still work).

@@ -79,6 +79,12 @@ std::string to_toml(const Config& c);
 /// One line per key: name, value, unit and meaning (for `ibrod check` and docs).
 std::string describe(const Config& c);
 
+/// "key: old → new; …" for every key whose value differs between the configuration `old_toml`
+/// (a run's config.toml or a checkpoint's, read from `source`) and `now`; "" if none. A document
+/// this ibrod cannot read is reported as a difference.
+std::string config_differences(const std::string& old_toml, const Config& now,
+                               const std::string& source);
+
 /// Convert to internal units (g, Å, s) for the simulation.
 sim::SimParams to_params(const Config& c);
 

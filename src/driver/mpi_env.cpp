@@ -1,5 +1,10 @@
 #include "driver/mpi_env.hpp"
 
+#include <functional>
+#include <stdexcept>
+
+#include "core/error.hpp"
+
 #include <cstdlib>
 
 #ifdef IBROD_MPI
@@ -93,5 +98,41 @@ void finalize([[maybe_unused]] const World& w) {
   if (w.initialized) MPI_Finalize();
 #endif
 }
+
+// Under MPI (ranks > 1) rank 0 alone writes files. What it writes may fail (disk full, an
+// output directory in the way) while the other ranks carry on into the next collective and wait
+// forever: on_root runs f on rank 0 only and then every rank throws what rank 0 threw (the same
+// type, ConfigError, RunError or std::runtime_error, and message), so that all ranks stop at the
+// same point with the same exit status. One broadcast per call; without MPI it is f().
+
+void on_root(int rank, int ranks, const std::function<void()>& f) {
+  if (ranks <= 1) {
+    f();
+    return;
+  }
+  long long kind = 0;
+  std::string what;
+  if (rank == 0) {
+    try {
+      f();
+    } catch (const ConfigError& e) {
+      kind = 2;
+      what = e.what();
+    } catch (const RunError& e) {
+      kind = 3;
+      what = e.what();
+    } catch (const std::exception& e) {
+      kind = 1;
+      what = e.what();
+    }
+  }
+  kind = broadcast(kind);
+  if (kind == 0) return;
+  what = broadcast(what);
+  if (kind == 2) throw ConfigError(what);
+  if (kind == 3) throw RunError(what);
+  throw std::runtime_error(what);
+}
+
 
 }  // namespace ibrod::driver::mpi

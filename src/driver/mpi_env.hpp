@@ -3,6 +3,7 @@
 // initialises MPI only when started by a launcher (`mpirun -np K ibrod …`), so that a plain
 // `ibrod run`, and every run a sweep spawns, stays a one-process program without MPI.
 // Without IBROD_MPI every function here is the one-rank answer.
+#include <functional>
 #include <string>
 
 namespace ibrod::driver::mpi {
@@ -30,6 +31,11 @@ long long max(long long v);
 long long broadcast(long long v);
 /// rank 0's s on every rank (s itself without MPI).
 std::string broadcast(const std::string& s);
+/// Runs f on rank 0 only; then every rank throws what rank 0 threw (ConfigError, RunError or
+/// std::runtime_error, with its message), so that all ranks stop at the same point with the same
+/// exit status (rank 0 alone writes files: a full disk must not leave the others waiting in the
+/// next collective). One broadcast per call; with one rank it is f().
+void on_root(int rank, int ranks, const std::function<void()>& f);
 /// MPI_Finalize if init() initialised MPI.
 void finalize(const World& w);
 

@@ -1,7 +1,7 @@
 #pragma once
 // The run driver behind `ibrod run`: output directory, time loop, diagnostics rows, trajectory,
-// checkpoints, progress, final state and summary. Files written into the output directory
-// (docs/outputs.md describes each):
+// checkpoints, progress, final state and summary. Files written into the output directory are
+// named by io::RunDir (docs/outputs.md describes each):
 //   config.toml        the resolved configuration (every key)
 //   timeseries.csv     one row per output step (columns: timeseries_header())
 //   trajectory.h5      H5MD trajectory: frames every output.frame_every_steps, observables, config
@@ -17,6 +17,7 @@
 // and recomputes them; the result is bitwise identical to a run that was never interrupted
 // (same plans through fftw.wisdom, the same thread count, deterministic reductions).
 #include <cstdio>
+#include <memory>
 #include <string>
 
 #include "config/config.hpp"
@@ -60,9 +61,32 @@ struct RunResult {
 /// |Lk − Lk(0)| beyond which a run warns (once) of a likely self-passage.
 inline constexpr double kLinkDriftWarning = 0.1;
 
-/// Run (or, with opt.resume, continue) one trajectory. Throws ConfigError (bad config, output
-/// directory exists, unusable checkpoint) or RunError (blow-up, I/O failure: disk full, …).
-/// A SIGINT/SIGTERM does not throw: the result has signal set.
+/// One trajectory from its configuration to its final files: prepares the output directory (or
+/// checks the checkpoint to continue from), builds the Simulation, runs its time loop — writing
+/// rows, frames and checkpoints when the Simulation's schedule says so, watching for blow-ups
+/// and signals, printing progress — and writes the final state and summary.json.
+///
+///   Run r(config, options);   // validates; nothing written yet
+///   RunResult result = r.execute();
+///
+/// Under MPI (options.ranks > 1) every rank constructs a Run and calls execute(); rank 0 alone
+/// writes files and progress. execute() throws ConfigError (bad config, output directory
+/// exists, unusable checkpoint) or RunError (blow-up, I/O failure: disk full, …); a SIGINT or
+/// SIGTERM does not throw: the result has `signal` set.
+class Run {
+ public:
+  Run(const config::Config& c, const RunOptions& opt);
+  ~Run();
+  Run(const Run&) = delete;
+  Run& operator=(const Run&) = delete;
+  RunResult execute();
+
+ private:
+  struct State;
+  std::unique_ptr<State> s_;
+};
+
+/// Run(c, opt).execute().
 RunResult run(const config::Config& c, const RunOptions& opt);
 
 }  // namespace ibrod::driver

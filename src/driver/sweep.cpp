@@ -1,4 +1,5 @@
 #include "driver/sweep.hpp"
+#include "driver/signals.hpp"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -21,6 +22,8 @@
 #include <toml++/toml.h>
 
 #include "core/error.hpp"
+#include "core/text_file.hpp"
+#include "config/toml_error.hpp"
 #include "io/atomic_file.hpp"
 
 extern char** environ;
@@ -127,22 +130,7 @@ Config config_of(const toml::table& tree, const std::string& source) {
 }
 
 toml::table parse_table(const std::string& text, const std::string& source) {
-  try {
-    return toml::parse(text, source);
-  } catch (const toml::parse_error& e) {
-    std::ostringstream os;
-    os << "sweep: " << source << ":" << e.source().begin.line << ":" << e.source().begin.column
-       << ": TOML syntax error: " << e.description();
-    throw ConfigError(os.str());
-  }
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  if (!in) return {};
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
+  return config::parse_toml(text, source, "sweep");
 }
 
 // Short names in point names: a few well-known keys, otherwise the last part of the key.
@@ -208,10 +196,7 @@ Sweep parse_sweep(const std::string& text, const std::string& source, const fs::
     auto path = b->value_exact<std::string>();
     if (!path) throw ConfigError(where + ": base = " + toml_text(*b) + " is invalid: expected a file name (string)");
     const fs::path p = fs::path(*path).is_absolute() ? fs::path(*path) : dir / *path;
-    std::error_code ec;
-    if (!fs::is_regular_file(p, ec))
-      throw ConfigError(where + ": base = \"" + *path + "\": cannot read file '" + p.string() + "'");
-    tree = parse_table(slurp(p), p.string());
+    tree = parse_table(read_text_file(p, where + ": base = \"" + *path + "\""), p.string());
     if (tree.contains("sweep") || tree.contains("base"))
       throw ConfigError(where + ": base = \"" + *path + "\" must be a plain config (no [sweep], no base)");
   }
@@ -338,10 +323,7 @@ Sweep parse_sweep(const std::string& text, const std::string& source, const fs::
 }
 
 Sweep load_sweep(const fs::path& file) {
-  std::error_code ec;
-  if (!fs::is_regular_file(file, ec))
-    throw ConfigError("sweep: cannot read file '" + file.string() + "'");
-  return parse_sweep(slurp(file), file.string(), file.parent_path());
+  return parse_sweep(read_text_file(file, "sweep"), file.string(), file.parent_path());
 }
 
 std::string points_csv(const Sweep& sw) {
@@ -381,7 +363,7 @@ const char* to_string(PointState s) {
 namespace {
 
 std::string summary_stop_reason(const fs::path& dir) {
-  const std::string text = slurp(dir / "summary.json");
+  const std::string text = try_read_text_file(dir / "summary.json").value_or("");
   if (text.empty()) return "";
   try {
     const auto j = nlohmann::json::parse(text);
@@ -407,33 +389,6 @@ PointState point_state(const fs::path& dir) {
 // ---- running ----------------------------------------------------------------------------------
 
 namespace {
-
-volatile std::sig_atomic_t g_sweep_signal = 0;
-void on_sweep_signal(int s) { g_sweep_signal = s; }
-
-// SIGINT/SIGTERM set g_sweep_signal (no SA_RESTART: waitpid returns EINTR); restored on exit.
-class SweepSignals {
- public:
-  explicit SweepSignals(bool on) : on_(on) {
-    if (!on_) return;
-    g_sweep_signal = 0;
-    struct sigaction sa {};
-    sa.sa_handler = on_sweep_signal;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, &old_int_);
-    sigaction(SIGTERM, &sa, &old_term_);
-  }
-  ~SweepSignals() {
-    if (!on_) return;
-    sigaction(SIGINT, &old_int_, nullptr);
-    sigaction(SIGTERM, &old_term_, nullptr);
-  }
-  int pending() const { return on_ ? int(g_sweep_signal) : 0; }
-
- private:
-  bool on_;
-  struct sigaction old_int_ {}, old_term_ {};
-};
 
 std::string self_exe() {
   std::error_code ec;
@@ -484,7 +439,7 @@ pid_t spawn_run(const std::string& binary, const std::vector<std::string>& args,
 }
 
 std::string last_line(const fs::path& log) {
-  const std::string text = slurp(log);
+  const std::string text = try_read_text_file(log).value_or("");
   std::size_t e = text.find_last_not_of("\r\n ");
   if (e == std::string::npos) return "";
   std::size_t b = text.find_last_of("\r\n", e);
@@ -530,7 +485,7 @@ SweepReport run_sweep(const Sweep& sw, const SweepOptions& opt) {
     const PointState st = point_state(dir);
     if (st == PointState::finished || st == PointState::interrupted) {
       // a directory of an earlier, different sweep: never resume or count it as this point
-      if (slurp(dir / "config.toml") != config_text) {
+      if (try_read_text_file(dir / "config.toml").value_or("") != config_text) {
         fail(pt, "the run in " + dir.string() + " has another configuration than this sweep "
                  "gives the point; move it away (or delete it) to run the point again");
         continue;
@@ -554,7 +509,7 @@ SweepReport run_sweep(const Sweep& sw, const SweepOptions& opt) {
       " to run, " + std::to_string(jobs) + " at a time -> " + root.string());
 
   // ---- K children at a time
-  SweepSignals signals(opt.handle_signals);
+  SignalGuard signals(opt.handle_signals, SignalGuard::Mode::sweep);
   const std::vector<std::string> env = child_environment(jobs);
   struct Running {
     const SweepPoint* pt;

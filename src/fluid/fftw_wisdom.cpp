@@ -31,6 +31,15 @@ bool export_wisdom(const std::string& path) {
   return init_threads() && fftw_export_wisdom_to_filename(path.c_str()) != 0;
 }
 
+std::string wisdom_text() {
+  if (!init_threads()) return {};
+  char* text = fftw_export_wisdom_to_string();
+  if (!text) return {};
+  std::string out(text);
+  std::free(text);
+  return out;
+}
+
 std::string wisdom_cache_path() {
   if (const char* p = std::getenv("IBROD_FFTW_WISDOM_CACHE")) return p;  // "" disables
   if (const char* x = std::getenv("XDG_CACHE_HOME"); x && *x)

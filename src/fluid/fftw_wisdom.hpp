@@ -23,6 +23,8 @@ bool export_wisdom(const std::string& path);
 /// if set (empty: no cache), else $XDG_CACHE_HOME/ibrod/fftw-wisdom, else
 /// $HOME/.cache/ibrod/fftw-wisdom ("" if none of them is set).
 std::string wisdom_cache_path();
+/// The process's FFTW wisdom as text (what export_wisdom writes); "" on failure.
+std::string wisdom_text();
 
 /// Writes this process's wisdom to the cache file `path` (its folder made if missing), by a
 /// temporary file and a rename, so that concurrent processes never see a half-written file. Best

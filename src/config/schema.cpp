@@ -1,27 +1,31 @@
-#include "config/config.hpp"
-
 #include <cmath>
-#include <fstream>
 #include <functional>
 #include <limits>
-#include <numbers>
 #include <sstream>
 
 #include <toml++/toml.h>
 
+#include "config/config.hpp"
+#include "config/detail.hpp"
+#include "config/toml_error.hpp"
 #include "core/error.hpp"
+#include "core/text_file.hpp"
 #include "core/units.hpp"
 #include "interactions/interactions.hpp"
 
+// The schema of the user's configuration: every key, how it is read from TOML or `--set`, how it
+// is written back, and its unit and meaning.
 namespace ibrod::config {
 
-using rod::combined_perturbation;
+using detail::bad;
+using detail::fmt;
 using rod::draw_perturbation;
 using rod::RandomPerturbation;
 
 Config::Config()
     : electrostatics_cutoff_debye(interactions::kDefaultCutoffDebye),
       steric_stiffness_kT_A2(interactions::kDefaultStericStiffness / units::kT(300.0)) {}
+
 
 namespace {
 
@@ -31,16 +35,6 @@ std::string show(const toml::node& n) {
   return os.str();
 }
 
-std::string fmt(double v) {
-  std::ostringstream os;
-  os.precision(12);
-  os << v;
-  return os.str();
-}
-
-[[noreturn]] void bad(const std::string& key, const std::string& value, const std::string& allowed) {
-  throw ConfigError("config: " + key + " = " + value + " is invalid: expected " + allowed);
-}
 
 // One config key: how to read it from TOML into Config, and how to write it back.
 struct Key {
@@ -344,16 +338,9 @@ std::int64_t frame_every(const Config& c) {
   return c.output_frame_every_steps < 0 ? c.output_every_steps : c.output_frame_every_steps;
 }
 
+
 void apply_toml(Config& c, const std::string& text, const std::string& source) {
-  toml::table tbl;
-  try {
-    tbl = toml::parse(text, source);
-  } catch (const toml::parse_error& e) {
-    std::ostringstream os;
-    os << "config: " << source << ":" << e.source().begin.line << ":" << e.source().begin.column
-       << ": TOML syntax error: " << e.description();
-    throw ConfigError(os.str());
-  }
+  const toml::table tbl = parse_toml(text, source, "config");
   for (auto&& [sec, node] : tbl) {
     const std::string s(sec.str());
     const toml::table* t = node.as_table();
@@ -364,16 +351,14 @@ void apply_toml(Config& c, const std::string& text, const std::string& source) {
   }
 }
 
+
 Config load_config(const std::string& path) {
   Config c;
   if (path.empty()) return c;
-  std::ifstream in(path);
-  if (!in) throw ConfigError("config: cannot read file '" + path + "'");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  apply_toml(c, ss.str(), path);
+  apply_toml(c, read_text_file(path, "config"), path);
   return c;
 }
+
 
 void apply_override(Config& c, const std::string& assignment) {
   const auto eq = assignment.find('=');
@@ -392,34 +377,6 @@ void apply_override(Config& c, const std::string& assignment) {
   set_key(c, key, *t.get("v"));
 }
 
-void validate(const Config& c) {
-  if (c.grid_n % 2 != 0)
-    bad("grid.n", std::to_string(c.grid_n), "an even integer >= 8 (real-to-complex FFT grid)");
-  if (4 * c.grid_kernel_width + 2 > c.grid_n)
-    bad("grid.kernel_width", std::to_string(c.grid_kernel_width),
-        "an integer m with 4m + 2 <= grid.n = " + std::to_string(c.grid_n) +
-            " (the kernel must fit in the grid)");
-  const double r0 = c.rod_base_pairs * c.rod_rise_A / (2 * std::numbers::pi);
-  const double extent = 2 * r0 + c.steric_diameter_A;
-  if (extent >= c.grid_box_A)
-    bad("grid.box_A", fmt(c.grid_box_A),
-        "a box larger than the ring: rod.base_pairs = " + std::to_string(c.rod_base_pairs) +
-            " at rod.rise_A = " + fmt(c.rod_rise_A) + " gives a ring of diameter " +
-            fmt(2 * r0) + " Å (plus the hard core " + fmt(c.steric_diameter_A) + " Å)");
-  if (c.time_dt_ns * 1e-3 > c.time_t_end_us)
-    bad("time.t_end_us", fmt(c.time_t_end_us),
-        "at least one time step (time.dt_ns = " + fmt(c.time_dt_ns) + " ns)");
-  // MODEL §5: sin β must be a sine
-  const double a = c.rod_bend_modulus_erg_cm * units::erg_cm;
-  const double a3 = c.rod_twist_modulus_erg_cm * units::erg_cm;
-  const double b = c.rod_shear_modulus_dyn * units::dyn;
-  const double rr = c.rod_rise_A * c.rod_base_pairs / (2 * std::numbers::pi);
-  const double sb = -a3 * c.rod_excess_link / (b * rr * rr + a3 - a);
-  if (!(std::abs(sb) < 1))
-    bad("rod.excess_link", std::to_string(c.rod_excess_link),
-        "a link small enough that the twisted circle exists (|sin β| = " + fmt(std::abs(sb)) +
-            " >= 1)");
-}
 
 std::string to_toml(const Config& c) {
   toml::table root;
@@ -433,6 +390,7 @@ std::string to_toml(const Config& c) {
   return os.str();
 }
 
+
 std::string describe(const Config& c) {
   std::ostringstream os;
   for (const Key& k : schema()) {
@@ -440,86 +398,6 @@ std::string describe(const Config& c) {
     if (lhs.size() < 44) lhs.resize(44, ' ');
     os << lhs << " # " << k.help << "\n";
   }
-  return os.str();
-}
-
-sim::SimParams to_params(const Config& c) {
-  using namespace units;
-  sim::SimParams p;
-  auto& s = p.stepper;
-  s.grid.n = c.grid_n;
-  s.grid.L = c.grid_box_A * angstrom;
-  s.kernel_width = c.grid_kernel_width;
-  s.fluid.density = c.solvent_density_g_cm3 * g_per_cm3;
-  s.fluid.viscosity = c.solvent_viscosity_poise * poise;
-  s.fluid.dt = c.time_dt_ns * ns;
-  s.fluid.advection = c.solvent_advection;
-  s.rod.n = c.rod_base_pairs;
-  s.rod.ds = c.rod_rise_A * angstrom;
-  const double a = c.rod_bend_modulus_erg_cm * erg_cm;
-  s.rod.a = Vec3(a, a, c.rod_twist_modulus_erg_cm * erg_cm);
-  const double b = c.rod_shear_modulus_dyn * dyn;
-  s.rod.b = Vec3(b, b, c.rod_stretch_modulus_dyn * dyn);
-  s.rod.omega0 = Vec3(0, 0, c.rod_intrinsic_twist_per_A);
-  p.kT = kT(c.solvent_temperature_K);
-  // MODEL (2.19–2.22): A = q²/(4π ε0 εw), κ = 0.329 √Cs
-  s.electro.enabled = c.electrostatics_enabled;
-  s.electro.law.A = c.electrostatics_charge_e * c.electrostatics_charge_e /
-                    (4 * std::numbers::pi * vacuum_permittivity * c.electrostatics_dielectric);
-  s.electro.law.kappa = debye_kappa(c.solvent_salt_M);
-  s.electro.cutoff =
-      s.electro.law.kappa > 0 ? c.electrostatics_cutoff_debye / s.electro.law.kappa : 0.0;
-  s.steric.enabled = c.steric_enabled;
-  s.steric.diameter = c.steric_diameter_A;
-  s.steric.stiffness = c.steric_stiffness_kT_A2 * p.kT;
-  s.steric.ds = s.rod.ds;
-  s.threads = c.run_threads;
-  s.plan_measure = c.run_fftw_measure;
-  p.circle.excess_link = c.rod_excess_link;
-  p.circle.perturbation = combined_perturbation(c.rod_perturbation, c.rod_perturbation_random);
-  // the ring sits in the middle of the box
-  p.circle.center = Vec3::Constant(0.5 * s.grid.L);
-  p.t_end = c.time_t_end_us * us;
-  p.stop_kinetic = c.time_stop_kinetic_kT * p.kT;
-  p.output_every = c.output_every_steps;
-  return p;
-}
-
-std::string derived_report(const Config& c) {
-  const auto p = to_params(c);
-  const auto& s = p.stepper;
-  const double h = s.grid.h();
-  const double r0 = s.rod.n * s.rod.ds / (2 * std::numbers::pi);
-  const double sb = -s.rod.a[2] * c.rod_excess_link / (s.rod.b[0] * r0 * r0 + s.rod.a[2] - s.rod.a[0]);
-  const auto steps = int64_t(std::ceil(p.t_end / s.fluid.dt - 0.5));
-  const double N3 = double(s.grid.size());
-  // velocity + force (3 real arrays each) + spectrum (3 complex half arrays)
-  const double fluid_bytes = 8.0 * (6 * N3 + 2 * 3 * s.grid.n * s.grid.n * (s.grid.n / 2 + 1));
-  std::ostringstream os;
-  os.precision(5);
-  os << "grid spacing h            = " << h << " Å\n"
-     << "kernel width c            = " << c.grid_kernel_width * h << " Å (" << c.grid_kernel_width
-     << " h)\n"
-     << "rod spacing Δs            = " << s.rod.ds << " Å\n"
-     << "ring radius r0            = " << r0 << " Å\n"
-     << "tilt angle β              = " << std::asin(sb) << " rad\n"
-     << "kT                        = " << p.kT << " g Å² s⁻²\n"
-     << "Debye length 1/κ          = "
-     << (s.electro.law.kappa > 0 ? 1.0 / s.electro.law.kappa : INFINITY) << " Å\n"
-     << "Bjerrum length            = "
-     << units::bjerrum_length(c.electrostatics_dielectric, c.solvent_temperature_K) << " Å\n"
-     << "electrostatic cutoff      = " << s.electro.cutoff << " Å\n"
-     << "steric stiffness g        = " << s.steric.stiffness << " g s⁻²\n"
-     << "time steps                = " << steps << "\n"
-     << "diagnostics rows          = " << steps / p.output_every + 1 << "\n"
-     << "memory estimate           = " << (fluid_bytes + 400.0 * s.rod.n) / (1 << 20) << " MiB\n";
-  // docs/outputs.md: checkpoint = 3 N³ velocities + 12 n rod numbers; a frame = 4 × n × 3 numbers
-  const std::int64_t fevery = frame_every(c);
-  const std::int64_t frames = fevery > 0 ? steps / fevery + 1 : 0;
-  os << "checkpoint size           = " << (24.0 * N3 + 96.0 * s.rod.n) / (1 << 20) << " MiB\n"
-     << "trajectory frames         = " << frames << " (H5MD ≈ "
-     << frames * 96.0 * s.rod.n / (1 << 20) << " MiB, .vtp ≈ "
-     << frames * 270.0 * s.rod.n / (1 << 20) << " MiB)\n";
   return os.str();
 }
 
