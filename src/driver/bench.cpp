@@ -6,6 +6,7 @@
 #include <chrono>
 #include <limits>
 
+#include "integrate/stepper.hpp"
 #include "sim/simulation.hpp"
 
 namespace ibrod::driver {
@@ -19,7 +20,7 @@ double ms_since(Clock::time_point t) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
 }
 
-// Timings on a shared 2-core machine are noisy: everything is measured in `kRounds` interleaved
+// Timings on a shared machine are noisy: everything is measured in `kRounds` interleaved
 // rounds (full steps, the phases, the FFTs alone), and each figure is the minimum over the rounds
 // of its per-round mean, so that a burst of load in one round does not bias one figure only.
 constexpr int kRounds = 5;
@@ -30,10 +31,8 @@ BenchResult bench(const Config& c, int steps) {
   validate(c);
   sim::Simulation s(to_params(c));
   auto& st = s.stepper();
-  const auto& p = st.params();
   auto& rod = s.rod();
   auto& fl = st.fluid();
-  const int n = rod.size();
   BenchResult r;
   r.steps = steps;
   r.threads = fl.threads();
@@ -41,23 +40,13 @@ BenchResult bench(const Config& c, int steps) {
   // Warm up (first touches, caches).
   for (int i = 0; i < std::min(steps, 10); ++i) s.step();
 
-  // Private buffers for the phase-by-phase step, and a copy of the velocity to put back after the
-  // FFTs alone have clobbered it.
-  std::vector<Vec3> F(n), T(n), U(n), W(n);
-  rod::RodWork work;
-  work.resize(n);
+  // A copy of the velocity to put back after the FFTs alone have clobbered it.
   const std::size_t n3 = fl.grid().size();
   std::vector<double> saved(3 * n3);
-
-  constexpr int kPh = 8;
-  const char* names[kPh] = {"rod forces",  "pair forces",       "kernel weights",
-                            "rhs+spread+2D FFT", "x FFTs+solve", "2D iFFT+interp.",
-                            "interp. sums",      "update"};
-  const integrate::PlaneCouplerForcing forcing(st.plane_coupler());
-  const integrate::PlaneCouplerSampler sampler(st.plane_coupler());
+  constexpr int kPhases = integrate::StepPhaseTimes::kCount;
   constexpr double inf = std::numeric_limits<double>::infinity();
-  double best_ph[kPh];
-  std::fill(best_ph, best_ph + kPh, inf);
+  double best_phase[kPhases];
+  std::fill(best_phase, best_phase + kPhases, inf);
   double best_step = inf, best_fft = inf, best_split = inf;
   const int per_round = std::max(1, steps / kRounds);
 
@@ -67,39 +56,12 @@ BenchResult bench(const Config& c, int steps) {
     for (int i = 0; i < per_round; ++i) s.step();
     best_step = std::min(best_step, ms_since(t) / per_round);
 
-    // 2. the same work phase by phase (same order and calls as Stepper::step); the fluid half
-    // is split into the three passes of FluidSolver::finish_step
-    double ph[kPh] = {};
-    for (int i = 0; i < per_round; ++i) {
-      t = Clock::now();
-      std::fill(F.begin(), F.end(), Vec3::Zero());
-      std::fill(T.begin(), T.end(), Vec3::Zero());
-      rod::elastic_forces(p.rod, rod, work, F, T);
-      ph[0] += ms_since(t);
-      t = Clock::now();
-      if (p.electro.enabled) st.electrostatics().accumulate(rod.X, F);
-      if (p.steric.enabled) st.steric().accumulate(rod.X, F);
-      ph[1] += ms_since(t);
-      t = Clock::now();
-      st.plane_coupler().prepare(rod.X, F, T);
-      ph[2] += ms_since(t);
-      t = Clock::now();
-      fl.pass_rhs_planes(&forcing);
-      ph[3] += ms_since(t);
-      t = Clock::now();
-      fl.pass_pencils();
-      ph[4] += ms_since(t);
-      t = Clock::now();
-      fl.pass_inverse_planes(&sampler);
-      ph[5] += ms_since(t);
-      t = Clock::now();
-      st.plane_coupler().finish_interpolation(U, W);
-      ph[6] += ms_since(t);
-      t = Clock::now();
-      rod::advance(rod, U, W, p.fluid.dt);
-      ph[7] += ms_since(t);
-    }
-    for (int k = 0; k < kPh; ++k) best_ph[k] = std::min(best_ph[k], ph[k] / per_round);
+    // 2. the same steps, timed phase by phase (Stepper::step with a phase clock; the fluid
+    // half is split into the three passes of FluidSolver::step)
+    integrate::StepPhaseTimes phases;
+    for (int i = 0; i < per_round; ++i) st.step(rod, &phases);
+    for (int k = 0; k < kPhases; ++k)
+      best_phase[k] = std::min(best_phase[k], phases.ms[k] / per_round);
 
     // 3. FFTW's threaded 3-D transforms alone (the six FFTs of one step), on the solver's own
     // buffers; the velocity is saved and put back so that the trajectory goes on undisturbed
@@ -121,12 +83,13 @@ BenchResult bench(const Config& c, int steps) {
     for (int comp = 0; comp < 3; ++comp)
       std::copy_n(saved.begin() + comp * n3, n3, fl.velocity(comp));
   }
-  for (int k = 0; k < kPh; ++k) r.phases.push_back({names[k], best_ph[k]});
+  for (int k = 0; k < kPhases; ++k)
+    r.phases.push_back({integrate::StepPhaseTimes::kNames[k], best_phase[k]});
   r.step_ms = best_step;
   r.fftw3d_ms = best_fft;
   r.split_fft_ms = best_split;
   r.fft_ms = std::min(best_fft, best_split);
-  r.fluid_solve_ms = best_ph[3] + best_ph[4] + best_ph[5];
+  r.fluid_solve_ms = best_phase[3] + best_phase[4] + best_phase[5];
 
   // Diagnostics (output steps only).
   const int reps = std::max(1, std::min(steps / 10, 20));

@@ -352,7 +352,7 @@ std::string points_csv(const Sweep& sw) {
 const char* to_string(PointState s) {
   switch (s) {
     case PointState::fresh: return "fresh";
-    case PointState::restart: return "restart";
+    case PointState::no_checkpoint: return "no_checkpoint";
     case PointState::interrupted: return "interrupted";
     case PointState::finished: return "finished";
     case PointState::failed: return "failed";
@@ -383,7 +383,7 @@ PointState point_state(const fs::path& dir) {
   if (reason == "end_time" || reason == "equilibrium") return PointState::finished;
   if (reason == "blow_up") return PointState::failed;
   if (fs::exists(dir / "checkpoint.bin", ec)) return PointState::interrupted;
-  return PointState::restart;
+  return PointState::no_checkpoint;
 }
 
 // ---- running ----------------------------------------------------------------------------------
@@ -538,7 +538,7 @@ SweepReport run_sweep(const Sweep& sw, const SweepOptions& opt) {
         args = {"run", "--resume", dir.string()};
       } else {
         args = {"run", (root / "configs" / (t.pt->name + ".toml")).string(), "-o", dir.string()};
-        if (t.state == PointState::restart) args.push_back("--overwrite");
+        if (t.state == PointState::no_checkpoint) args.push_back("--overwrite");
       }
       const pid_t pid = spawn_run(binary, args, log, env);
       if (pid <= 0) {

@@ -67,7 +67,7 @@ std::string sanitize_name(const std::string& s);
 /// What a point's directory holds.
 enum class PointState {
   fresh,        ///< absent or empty: run it
-  restart,      ///< files but no checkpoint (killed before the first one): run it with --overwrite
+  no_checkpoint,  ///< files but no checkpoint (killed before the first one): run it with --overwrite
   interrupted,  ///< a checkpoint and no final summary: `ibrod run --resume`
   finished,     ///< summary.json says end_time or equilibrium: skip
   failed,       ///< summary.json says blow_up: not run again (delete the directory to retry)

@@ -69,13 +69,25 @@ struct PlaneCouplerSampler final : fluid::PlaneSampler {
   }
 };
 
+/// Wall time of each phase of the serial step, accumulated over the steps it is passed to
+/// (`ibrod bench`: the production step itself, timed phase by phase).
+struct StepPhaseTimes {
+  static constexpr int kCount = 8;
+  static constexpr const char* kNames[kCount] = {
+      "rod forces",        "pair forces",  "kernel weights",  "rhs+spread+2D FFT",
+      "x FFTs+solve",      "2D iFFT+interp.", "interp. sums", "update"};
+  double ms[kCount] = {};
+};
+
+class PhaseClock;
+
 class Stepper {
  public:
   explicit Stepper(const StepperParams& p);
   ~Stepper();
 
-  /// Advance rod and fluid by one Δt.
-  void step(rod::RodState& s);
+  /// Advance rod and fluid by one Δt. phases (serial fluid only): add each phase's wall time.
+  void step(rod::RodState& s, StepPhaseTimes* phases = nullptr);
 
   /// Rod forces only (step 1): fills the point forces and torques and returns the energies.
   StepEnergies compute_forces(const rod::RodState& s);
@@ -113,6 +125,7 @@ class Stepper {
   std::vector<Vec3> F_, T_, U_, W_;
   std::vector<double> rank_sum_;  // distributed: [6n] U then W, packed for sum_over_ranks
   const fluid::FluidSolver* serial_fluid() const;
+  StepEnergies forces(const rod::RodState& s, PhaseClock& clock);
   fluid::FluidSolver* serial_fluid();
 };
 

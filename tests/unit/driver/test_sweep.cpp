@@ -125,7 +125,7 @@ TEST(Sweep, PointStatesFollowTheRunFiles) {
   fs::create_directories(d);
   EXPECT_EQ(driver::point_state(d), driver::PointState::fresh);
   std::ofstream(d / "config.toml") << "x";
-  EXPECT_EQ(driver::point_state(d), driver::PointState::restart);
+  EXPECT_EQ(driver::point_state(d), driver::PointState::no_checkpoint);
   std::ofstream(d / "checkpoint.bin") << "x";
   EXPECT_EQ(driver::point_state(d), driver::PointState::interrupted);
   std::ofstream(d / "summary.json") << "{\"stop_reason\": \"interrupted\"}";
