@@ -1,4 +1,5 @@
-// `ibrod analyze` and `ibrod render` (cmd_analysis.hpp); the work is in io/analyze.hpp.
+// `ibrod analyze` and `ibrod render` (cmd_analysis.hpp); the work is in analysis/analyze.hpp and
+// analysis/frames.hpp.
 #include "cmd_analysis.hpp"
 
 #include <cstdio>
@@ -10,7 +11,7 @@
 
 #include "core/error.hpp"
 #include "exit_status.hpp"
-#include "analysis/analyze.hpp"
+#include "analysis/frames.hpp"
 #include "render/render.hpp"
 
 namespace {

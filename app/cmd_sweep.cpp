@@ -1,4 +1,4 @@
-// `ibrod sweep` (cmd_sweep.hpp); the work is in io/sweep.hpp.
+// `ibrod sweep` (cmd_sweep.hpp); the work is in driver/sweep_file.hpp and driver/sweep_runner.hpp.
 #include "cmd_sweep.hpp"
 
 #include <cstdio>
@@ -10,7 +10,7 @@
 #include "core/error.hpp"
 #include "exit_status.hpp"
 #include "driver/mpi_env.hpp"
-#include "driver/sweep.hpp"
+#include "driver/sweep_runner.hpp"
 
 namespace {
 

@@ -7,7 +7,7 @@
 
 #include <cstdlib>
 
-#include "driver/sweep.hpp"
+#include "driver/sweep_runner.hpp"
 #include "run_helpers.hpp"
 
 using namespace ibrod;

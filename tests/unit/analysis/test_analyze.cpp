@@ -19,6 +19,7 @@
 
 #include "core/error.hpp"
 #include "analysis/analyze.hpp"
+#include "analysis/frames.hpp"
 #include "render/image.hpp"
 
 namespace ibrod::analysis {

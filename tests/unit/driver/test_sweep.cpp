@@ -7,7 +7,7 @@
 #include <fstream>
 
 #include "core/error.hpp"
-#include "driver/sweep.hpp"
+#include "driver/sweep_runner.hpp"
 
 using namespace ibrod;
 using ::testing::HasSubstr;
