@@ -158,7 +158,7 @@ Key frame_key() {
 // rod.perturbation_random = { modes = M, amplitude = A, seed = S }: an inline table (a Key whose
 // value is a table). A partial table changes only the sub-keys it names, so that `--set
 // rod.perturbation_random.seed=7` (see set_key) works on top of a file's table. Written back as the
-// table; the drawn ε_m follow from it exactly (io/perturbation.hpp) and `ibrod check` shows them.
+// table; the drawn ε_m follow from it exactly (rod/perturbation.hpp) and `ibrod check` shows them.
 Key random_perturbation_key() {
   const std::string name = "rod.perturbation_random";
   const std::string help =

@@ -80,11 +80,11 @@ Observables Simulation::observe() {
   const int n = rod_.size();
   std::vector<Vec3> d1(n);
   for (int k = 0; k < n; ++k) d1[k] = rod_.D[k].col(0);
-  o.writhe = diag::writhe(rod_.X);
-  o.twist = diag::twist(rod_.X, d1);
+  o.writhe = diagnostics::writhe(rod_.X);
+  o.twist = diagnostics::twist(rod_.X, d1);
   o.link = o.writhe + o.twist;
-  o.closest_approach_A = diag::closest_approach(rod_.X, p_.closest_min_separation);
-  o.bp_spacing_A = diag::mean_spacing(rod_.X);
+  o.closest_approach_A = diagnostics::closest_approach(rod_.X, p_.closest_min_separation);
+  o.bp_spacing_A = diagnostics::mean_spacing(rod_.X);
   return o;
 }
 

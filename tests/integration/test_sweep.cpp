@@ -1,4 +1,4 @@
-// Sweeps end to end (io/sweep.hpp, `ibrod sweep`): the points run as real `ibrod run` processes;
+// Sweeps end to end (driver/sweep_runner.hpp, `ibrod sweep`): the points run as real `ibrod run` processes;
 // a sweep stopped part-way and started again finishes every point exactly once (finished points
 // skipped, the interrupted one resumed from its checkpoint, bitwise as if never stopped); a failed
 // point is reported and the others finish; under mpirun the ranks share the points.
@@ -8,6 +8,7 @@
 #include <cstdlib>
 
 #include "driver/sweep_runner.hpp"
+#include "helpers.hpp"
 #include "run_helpers.hpp"
 
 using namespace ibrod;
@@ -19,10 +20,13 @@ namespace {
 // 16³, 100 points, 200 Å box: 4 points (ΔLk 1, 2 × Cs 0.05, 0.1) of 1500 steps, checkpoints
 // every 100 steps, one thread each so that two can run side by side.
 std::string tiny_sweep() {
-  return "[grid]\nn = 16\nbox_A = 200\n[rod]\nbase_pairs = 100\n"
-         "[time]\ndt_ns = 0.1\nt_end_us = 0.15\n"
-         "[output]\nevery_steps = 50\nframe_every_steps = 0\ncheckpoint_every_steps = 100\n"
-         "[run]\nthreads = 1\nfftw_measure = false\n"
+  ibrod::config::Config c = ibrod::test::small_config(1);
+  c.time_t_end_us = 0.15;
+  c.output_every_steps = 50;
+  c.output_frame_every_steps = 0;
+  c.output_checkpoint_every_steps = 100;
+  c.run_threads = 1;
+  return ibrod::test::small_config_toml(c) +
          "[sweep]\n\"rod.excess_link\" = [1, 2]\n\"solvent.salt_M\" = [0.05, 0.1]\n";
 }
 
@@ -36,14 +40,14 @@ driver::SweepOptions options(const fs::path& root, int jobs, std::FILE* log = nu
 }
 
 std::string stop_reason(const fs::path& dir) {
-  const std::string s = slurp(dir / "summary.json");
+  const std::string s = read_file(dir / "summary.json");
   const auto p = s.find("\"stop_reason\": \"");
   return p == std::string::npos ? "" : s.substr(p + 16, s.find('"', p + 16) - p - 16);
 }
 
 // steps of the time series, in file order
 std::vector<long> steps_of(const fs::path& dir) {
-  std::istringstream in(slurp(dir / "timeseries.csv"));
+  std::istringstream in(read_file(dir / "timeseries.csv"));
   std::string line;
   std::getline(in, line);  // header
   std::vector<long> steps;
@@ -113,20 +117,20 @@ TEST(SweepRun, InterruptedPartWayAndStartedAgainFinishesEveryPointExactlyOnce) {
     for (long s = 0; s <= 1500; s += 50) want.push_back(s);
     EXPECT_EQ(steps_of(dir(i)), want) << i;
   }
-  EXPECT_THAT(slurp(dir(1) / "summary.json"), HasSubstr("\"resumes\": 1"));
+  EXPECT_THAT(read_file(dir(1) / "summary.json"), HasSubstr("\"resumes\": 1"));
   // the resumed point is bitwise the uninterrupted run of its config
   const Exit e = run_ibrod({"run", (root / "configs" / (sw.points[1].name + ".toml")).string(),
                             "-o", (d / "direct").string()},
                            d / "direct.log");
   ASSERT_EQ(e.code, 0) << e.output;
-  EXPECT_EQ(slurp(dir(1) / "final_state.csv"), slurp(d / "direct" / "final_state.csv"));
-  EXPECT_EQ(slurp(dir(1) / "timeseries.csv"), slurp(d / "direct" / "timeseries.csv"));
+  EXPECT_EQ(read_file(dir(1) / "final_state.csv"), read_file(d / "direct" / "final_state.csv"));
+  EXPECT_EQ(read_file(dir(1) / "timeseries.csv"), read_file(d / "direct" / "timeseries.csv"));
 
   // 3. a third time: nothing to do
   const driver::SweepReport again = driver::run_sweep(sw, options(root, 2));
   EXPECT_EQ(again.skipped, 4);
   EXPECT_EQ(again.fresh + again.resumed + again.failed, 0);
-  EXPECT_THAT(slurp(root / "points.csv"), HasSubstr("1,dlk=1_salt_M=0.1,1,0.1\n"));
+  EXPECT_THAT(read_file(root / "points.csv"), HasSubstr("1,dlk=1_salt_M=0.1,1,0.1\n"));
   fs::remove_all(d);
 }
 
@@ -144,7 +148,7 @@ TEST(SweepRun, AFailedPointIsReportedAndTheOthersFinish) {
   EXPECT_EQ(r.failed_names, std::vector<std::string>{"dt_ns=2"});
   EXPECT_EQ(r.completed, 1);
   EXPECT_EQ(stop_reason(d / "out" / "dt_ns=0.1"), "end_time");
-  EXPECT_THAT(slurp(d / "out" / "logs" / "dt_ns=2.log"), HasSubstr("blow-up"));
+  EXPECT_THAT(read_file(d / "out" / "logs" / "dt_ns=2.log"), HasSubstr("blow-up"));
   // again: the blown-up point is reported, not re-run; the finished one skipped
   const driver::SweepReport again = driver::run_sweep(sw, options(d / "out", 2));
   EXPECT_EQ(again.failed, 1);
@@ -163,10 +167,10 @@ TEST(SweepRun, APointDirectoryOfAnotherConfigurationIsNotTouched) {
   std::ofstream(d / "sweep.toml")
       << "[grid]\nn = 16\nbox_A = 200\n[rod]\nbase_pairs = 100\n[time]\nt_end_us = 0.02\n"
          "[run]\nthreads = 1\nfftw_measure = false\n[sweep]\n\"rod.excess_link\" = [3]\n";
-  const std::string before = slurp(d / "out" / "dlk=3" / "summary.json");
+  const std::string before = read_file(d / "out" / "dlk=3" / "summary.json");
   const driver::SweepReport r = driver::run_sweep(driver::load_sweep(d / "sweep.toml"), options(d / "out", 1));
   EXPECT_EQ(r.failed, 1);
-  EXPECT_EQ(slurp(d / "out" / "dlk=3" / "summary.json"), before);
+  EXPECT_EQ(read_file(d / "out" / "dlk=3" / "summary.json"), before);
   fs::remove_all(d);
 }
 
@@ -216,7 +220,7 @@ TEST(SweepCommand, UnderMpirunTheRanksShareThePoints) {
                               std::string(IBROD_BINARY) + " sweep " + (d / "sweep.toml").string() +
                               " > " + (d / "mpi.log").string() + " 2>&1")
                                  .c_str());
-  const std::string log = slurp(d / "mpi.log");
+  const std::string log = read_file(d / "mpi.log");
   ASSERT_EQ(rc, 0) << log;
   EXPECT_THAT(log, HasSubstr("sweep[0]: 2 points (rank 0 of 2)"));
   EXPECT_THAT(log, HasSubstr("sweep[1]: 2 points (rank 1 of 2)"));
