@@ -55,11 +55,15 @@ int sweep_main(const SweepArgs& a) {
     const long long points = ibrod::driver::mpi::sum(r.points);
     const long long completed = ibrod::driver::mpi::sum(r.completed);
     const long long skipped = ibrod::driver::mpi::sum(r.skipped);
+    const long long elsewhere = ibrod::driver::mpi::sum(r.running);
     if (world.size > 1 && root)
       std::printf("sweep: all ranks: %lld points, %lld finished now, %lld already finished, %lld "
                   "failed\n",
                   points, completed, skipped, failed);
-    status = sig ? 128 + int(sig) : failed > 0 ? 4 : 0;
+    if (elsewhere > 0 && root)
+      std::fprintf(stderr, "ibrod: sweep: %lld points are still being written by another process; "
+                           "run the sweep again when they are done\n", elsewhere);
+    status = sig ? 128 + int(sig) : (failed > 0 || elsewhere > 0) ? 4 : 0;
   } catch (const std::exception& e) {
     // a bad sweep file is the same on every rank: only rank 0 says so
     status = ibrod::app::report_error(e, root || !dynamic_cast<const ibrod::ConfigError*>(&e));

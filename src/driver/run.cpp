@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/text_file.hpp"
 #include "driver/mpi_env.hpp"
 #include "driver/progress.hpp"
 #include "driver/run_files.hpp"
@@ -68,9 +69,14 @@ struct Run::State {
   Clock::time_point t0 = Clock::now();
   bool distributed = false;
   Progress progress;
+  std::optional<DirLock> lock;               // rank 0: held while the run writes dir
 
   std::optional<io::Checkpoint> checkpoint;  // the one to continue from, until it is applied
   bool config_changed = false;
+  // a run that stopped but was killed before its final files were all written: --resume only
+  // writes them (the reason it stopped, from the checkpoint)
+  bool complete_only = false;
+  StopReason stopped_reason = StopReason::none;
   std::optional<sim::Simulation> sim;
   std::unique_ptr<RunFiles> files;           // rank 0 only
   std::vector<double> gathered;              // distributed: the whole velocity on rank 0
@@ -109,15 +115,29 @@ struct Run::State {
   std::string progress_line(const sim::Observables& o) const;
   void write_frame();
   void ensure_space() {
-    on_root([&] { files->ensure_space(reserve_bytes); });
+    on_root([&] { files->ensure_space(reserve_bytes, result.checkpoint_step >= 0); });
   }
   void write_checkpoint(StopReason reason);
   void finish(const sim::Observables& o, const std::string& stop_reason, const std::string& error);
   [[noreturn]] void blow_up(const std::string& what);
   sim::Observables observe_checked();
   void check_link(const sim::Observables& o);
+  bool final_files_complete(const std::string& stop_reason) const;
+  RunResult complete();
   RunResult loop(const SignalGuard& signals);
 };
+
+// Whether every final file of a run that stopped for `stop_reason` is there: summary.json with
+// that stop_reason, final_state.csv, velocity.npy if asked for.
+bool Run::State::final_files_complete(const std::string& stop_reason) const {
+  const auto summary = try_read_text_file(dir.summary());
+  if (!summary || summary->find("\"stop_reason\": \"" + stop_reason + "\"") == std::string::npos)
+    return false;
+  std::error_code ec;
+  if (!fs::exists(dir.final_state(), ec)) return false;
+  if (c.output_fluid_velocity && !fs::exists(dir.velocity(), ec)) return false;
+  return true;
+}
 
 void Run::State::check_launch() const {
   if (distributed && c.grid_n % opt.ranks != 0)
@@ -135,6 +155,8 @@ void Run::State::check_launch() const {
 void Run::State::open_checkpoint() {
   const fs::path cp = dir.checkpoint();
   std::error_code ec;
+  // one writer: the lock before the checkpoint is read (a run still writing it is refused)
+  if (fs::is_directory(dir.root(), ec)) on_root([&] { lock.emplace(dir.root()); });
   if (!fs::exists(cp, ec))
     throw ConfigError("resume: " + cp.string() +
                       " does not exist (the run stopped before its first checkpoint, or '" +
@@ -157,7 +179,27 @@ void Run::State::open_checkpoint() {
                       "then not the uninterrupted run of either configuration)");
   if (config_changed)
     say("ibrod: warning: resuming with a changed configuration (--force): " + diff);
-  if (ck.meta.stop_reason != "none" && !config_changed) {
+  // the time is state: a run never goes back (a shorter t_end than the checkpoint's time is an
+  // error, not a run that stops "at step 60/50")
+  const double dt = c.time_dt_ns * 1e-9, t_end = c.time_t_end_us * 1e-6;
+  const double time_ck = ck.meta.time_s >= 0 ? ck.meta.time_s : double(ck.meta.step) * dt;
+  if (t_end < time_ck - 0.5 * dt) {
+    char buf[320];
+    std::snprintf(buf, sizeof buf,
+                  "resume: time.t_end_us = %.6g is before the time of the checkpoint %s "
+                  "(%.6g us, step %lld): a run cannot go back; give a later time.t_end_us",
+                  c.time_t_end_us, cp.c_str(), time_ck / 1e-6,
+                  static_cast<long long>(ck.meta.step));
+    throw ConfigError(buf);
+  }
+  if (ck.meta.stop_reason != "none" && !config_changed && !final_files_complete(ck.meta.stop_reason)) {
+    // killed after its final checkpoint, before its final files: write them now
+    say("ibrod: the run in " + dir.root().string() + " stopped (" + ck.meta.stop_reason +
+        ") at step " + std::to_string(ck.meta.step) + " but its final files are incomplete; "
+        "writing them");
+    complete_only = true;
+    stopped_reason = sim::stop_reason_from(ck.meta.stop_reason);
+  } else if (ck.meta.stop_reason != "none" && !config_changed) {
     say("ibrod: the run in " + dir.root().string() + " already stopped (" +
         ck.meta.stop_reason + ") at step " + std::to_string(ck.meta.step) + "; nothing to do");
     result.already_finished = true;
@@ -177,7 +219,7 @@ void Run::State::prepare_directory() {
     return;
   }
   on_root([&] {
-    prepare_output_dir(dir, opt.overwrite);
+    prepare_output_dir(dir, opt.overwrite, lock);
     io::write_file_atomic(dir.config(), config_text);
   });
 }
@@ -351,6 +393,16 @@ sim::Observables Run::State::observe_checked() {
   return o;
 }
 
+RunResult Run::State::complete() {
+  loop_start = Clock::now();
+  start_step = sim->step_count();
+  last_row = sim->observe();
+  result.reason = stopped_reason;
+  meta.stop_reason = to_string(stopped_reason);
+  finish(last_row, to_string(stopped_reason), "");
+  return result;
+}
+
 void Run::State::check_link(const sim::Observables& o) {
   const double drift = std::abs(o.link - result.initial.link);
   meta.max_link_drift = std::max(meta.max_link_drift, drift);
@@ -390,7 +442,13 @@ RunResult Run::State::loop(const SignalGuard& signals) {
     }
 
     StopReason reason = StopReason::none;
-    for (;;) {
+    if (s.at_end()) {
+      // resumed at its end time (a checkpoint at t_end, or t_end moved to it): stop here
+      reason = StopReason::end_time;
+      write_checkpoint(reason);
+      progress.update(progress_line(last_row), seconds_since(loop_start), /*last=*/true);
+    }
+    while (reason == StopReason::none) {
       // distributed: the ranks agree on a signal (each may see it after another step)
       if (const int sig = distributed ? int(mpi::max(signals.pending())) : signals.pending()) {
         // the end of the current step: save it, then stop
@@ -437,14 +495,24 @@ RunResult Run::State::loop(const SignalGuard& signals) {
   } catch (const RunError& e) {
     // leave a summary that says why the run stopped, if the disk still takes one
     const std::string what = e.what();
-    if (what.rfind("run: blow-up", 0) != 0) {
-      try {
-        finish(last_row, to_string(StopReason::error), what);
-      } catch (const RunError&) {
-      }
+    if (what.rfind("run: blow-up", 0) == 0) {
+      progress.finish_line();
+      throw;
+    }
+    try {
+      finish(last_row, to_string(StopReason::error), what);
+    } catch (const RunError&) {
     }
     progress.finish_line();
-    throw;
+    // the advice that works: --resume needs a checkpoint
+    if (what.find("--resume") != std::string::npos || what.find("--overwrite") != std::string::npos)
+      throw;
+    throw RunError(what + (result.checkpoint_step >= 0
+                               ? "; once the cause is fixed, continue with: ibrod run --resume " +
+                                     dir.root().string()
+                               : "; the run stopped before its first checkpoint: once the cause "
+                                 "is fixed, start it again with --overwrite (ibrod run CONFIG -o " +
+                                     dir.root().string() + " --overwrite)"));
   }
 
   char buf[512];
@@ -481,6 +549,7 @@ RunResult Run::execute() {
   st.build_simulation();
   st.restore_state();
   st.open_files();
+  if (st.complete_only) return st.complete();
   st.announce();
   return st.loop(signals);
 }

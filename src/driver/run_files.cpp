@@ -10,23 +10,25 @@ namespace fs = std::filesystem;
 using io::CheckpointMeta;
 using io::observables_json;
 
-void prepare_output_dir(const io::RunDir& run_dir, bool overwrite) {
+void prepare_output_dir(const io::RunDir& run_dir, bool overwrite, std::optional<DirLock>& lock) {
   const fs::path& dir = run_dir.root();
   std::error_code ec;
-  if (fs::exists(dir, ec)) {
-    if (!fs::is_directory(dir, ec))
-      throw ConfigError("output: '" + dir.string() + "' exists and is not a directory");
-    if (!fs::is_empty(dir, ec) && !overwrite)
-      throw ConfigError("output: directory '" + dir.string() +
-                        "' already holds files; choose another -o DIR, pass --overwrite, or "
-                        "continue a stopped run with --resume " + dir.string());
-    if (overwrite) {
-      // stale frames or a stale checkpoint of an earlier run must not mix with this one
-      for (const fs::path& f : run_dir.run_files()) fs::remove_all(f, ec);
-    }
-  }
+  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
+    throw ConfigError("output: '" + dir.string() + "' exists and is not a directory");
   fs::create_directories(dir, ec);
   if (ec) throw RunError("output: cannot create '" + dir.string() + "': " + ec.message());
+  lock.emplace(dir);  // before anything is looked at or removed: one writer at a time
+  bool holds_files = false;
+  for (const auto& e : fs::directory_iterator(dir, ec))
+    if (e.path() != run_dir.lock()) holds_files = true;
+  if (holds_files && !overwrite)
+    throw ConfigError("output: directory '" + dir.string() +
+                      "' already holds files; choose another -o DIR, pass --overwrite, or "
+                      "continue a stopped run with --resume " + dir.string());
+  if (overwrite) {
+    // stale frames or a stale checkpoint of an earlier run must not mix with this one
+    for (const fs::path& f : run_dir.run_files()) fs::remove_all(f, ec);
+  }
 }
 
 // ---------------------------------------------------------------------------------------------

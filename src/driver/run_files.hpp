@@ -6,11 +6,13 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "config/config.hpp"
 #include "core/error.hpp"
 #include "core/text_file.hpp"
+#include "driver/dir_lock.hpp"
 #include "driver/progress.hpp"
 #include "driver/run.hpp"
 #include "io/atomic_file.hpp"
@@ -24,10 +26,11 @@
 
 namespace ibrod::driver {
 
-/// Makes the output directory of a fresh run: refuses a non-directory or (without overwrite) a
-/// directory that holds files; with overwrite removes every file an earlier run left
-/// (RunDir::run_files), so that stale frames or checkpoints never mix with the new run.
-void prepare_output_dir(const io::RunDir& dir, bool overwrite);
+/// Makes the output directory of a fresh run and takes its lock (into `lock`; ConfigError if
+/// another process writes it): refuses a non-directory or (without overwrite) a directory that
+/// holds files; with overwrite removes every file an earlier run left (RunDir::run_files), so
+/// that stale frames or checkpoints never mix with the new run.
+void prepare_output_dir(const io::RunDir& dir, bool overwrite, std::optional<DirLock>& lock);
 
 /// summary.json of a run that stopped (stop_reason) or failed (error non-empty).
 std::string summary_json(const config::Config& c, const RunResult& r,
@@ -73,14 +76,18 @@ class RunFiles {
   /// Throws RunError if the device of the output directory has less than `bytes` free: a full
   /// disk is better met before a write than in the middle of one (HDF5 cannot always recover a
   /// file whose write failed half-way).
-  void ensure_space(std::uintmax_t bytes) const {
+  /// has_checkpoint: the run has written a checkpoint, so `--resume` can continue it (otherwise
+  /// the advice is to start it again with --overwrite).
+  void ensure_space(std::uintmax_t bytes, bool has_checkpoint) const {
     std::error_code ec;
     const std::filesystem::space_info space = std::filesystem::space(dir_.root(), ec);
     if (!ec && space.available < bytes)
       throw RunError("output: only " + std::to_string(space.available >> 20) + " MiB left on the "
                      "device of " + dir_.root().string() + " (disk full?); stopped before writing, so "
-                     "every file is intact: free space and continue with --resume " +
-                     dir_.root().string());
+                     "every file is intact: free space and " +
+                     (has_checkpoint ? "continue with --resume " + dir_.root().string()
+                                     : "start the run again with --overwrite (it stopped before "
+                                       "its first checkpoint)"));
   }
 
   void row(const sim::Observables& o) {

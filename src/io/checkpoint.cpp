@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.hpp"
+#include "core/text_file.hpp"
 #include "io/atomic_file.hpp"
 #include "io/observables.hpp"
 #include "io/observables_json.hpp"
@@ -161,6 +162,8 @@ void write_checkpoint(const std::filesystem::path& path, const CheckpointMeta& m
 
 Checkpoint read_checkpoint(const std::filesystem::path& path) {
   const std::string name = path.string();
+  if (const std::string why = unreadable_reason(path); !why.empty())
+    throw ConfigError("checkpoint " + name + " cannot be read: " + why);
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) throw ConfigError("checkpoint " + name + " cannot be read (missing or no permission)");
   const std::streamoff size = in.tellg();

@@ -7,6 +7,7 @@
 
 #include <cstdlib>
 
+#include "driver/dir_lock.hpp"
 #include "driver/sweep_runner.hpp"
 #include "helpers.hpp"
 #include "run_helpers.hpp"
@@ -229,4 +230,29 @@ TEST(SweepCommand, UnderMpirunTheRanksShareThePoints) {
     EXPECT_EQ(stop_reason(d / "out" / n), "end_time") << n;
   fs::remove_all(d);
 #endif
+}
+
+TEST(SweepRun, APointWrittenByAnotherProcessIsNotStartedAndNotCountedFinished) {
+  // the orphaned run of a killed sweep still writes point 0 (here: this process holds its lock);
+  // the rerun sweep must not start a second writer there, nor call the point finished
+  const fs::path d = fresh_dir("sweep_locked");
+  std::ofstream(d / "sweep.toml") << tiny_sweep();
+  const driver::Sweep sw = driver::load_sweep(d / "sweep.toml");
+  const fs::path root = d / "out";
+  const fs::path point0 = root / sw.points[0].name;
+  fs::create_directories(point0);
+  std::ofstream(point0 / "timeseries.csv") << "step,time_us\n";  // the other writer's file
+  {
+    const driver::DirLock held(point0);
+    EXPECT_EQ(driver::point_state(point0), driver::PointState::running);
+    const driver::SweepReport r = driver::run_sweep(sw, options(root, 2));
+    EXPECT_EQ(r.running, 1);
+    EXPECT_EQ(r.completed, 3);
+    EXPECT_EQ(r.failed, 0);
+    EXPECT_EQ(read_file(point0 / "timeseries.csv"), "step,time_us\n");  // untouched
+    EXPECT_FALSE(fs::exists(point0 / "summary.json"));
+  }
+  // once the other writer is gone the point is run like any interrupted or fresh one
+  EXPECT_NE(driver::point_state(point0), driver::PointState::running);
+  fs::remove_all(d);
 }
