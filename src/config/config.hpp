@@ -21,6 +21,11 @@ struct Config {
   double time_dt_ns = 0.1;         ///< time.dt_ns: Δt, ns
   double time_t_end_us = 0.5;      ///< time.t_end_us: simulated time, µs
   double time_stop_kinetic_kT = 1e-12;  ///< time.stop_kinetic_kT: stop when E_K below, kT (0: never)
+  bool time_stability_test = true;         ///< test a state before calling it an equilibrium
+  double time_stability_amplitude_rad = 0.05;  ///< twist perturbation of the test, rad
+  double time_stability_probe_us = 0.5;        ///< how long the perturbed copy is integrated, µs
+  double time_stability_tolerance_kT = 1e-3;   ///< an energy drop beyond this: unstable, kT
+  std::int64_t time_stability_seed = 1;        ///< seed of the test's perturbation
   // [rod]
   int rod_base_pairs = 600;        ///< rod.base_pairs: rod points n
   int rod_excess_link = 6;         ///< rod.excess_link: ΔLk (integer)

@@ -79,6 +79,11 @@ sim::SimParams to_params(const Config& c) {
   p.circle.center = Vec3::Constant(0.5 * s.grid.L);
   p.t_end = c.time_t_end_us * us;
   p.stop_kinetic = c.time_stop_kinetic_kT * p.kT;
+  p.stability.enabled = c.time_stability_test;
+  p.stability.amplitude = c.time_stability_amplitude_rad;
+  p.stability.time = c.time_stability_probe_us * us;
+  p.stability.tolerance = c.time_stability_tolerance_kT * p.kT;
+  p.stability.seed = std::uint64_t(c.time_stability_seed);
   p.output.rows = c.output_every_steps;
   p.output.frames = frame_every(c);
   p.output.checkpoints = c.output_checkpoint_every_steps;

@@ -11,6 +11,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "core/error.hpp"
 #include "core/text_file.hpp"
 #include "driver/mpi_env.hpp"
@@ -25,6 +27,7 @@
 #include "io/npy.hpp"
 #include "io/run_dir.hpp"
 #include "sim/rod_problem.hpp"
+#include "sim/stability.hpp"
 
 namespace ibrod::driver {
 
@@ -122,6 +125,7 @@ struct Run::State {
   [[noreturn]] void blow_up(const std::string& what);
   sim::Observables observe_checked();
   void check_link(const sim::Observables& o);
+  StopReason test_stability(StopReason candidate);
   bool final_files_complete(const std::string& stop_reason) const;
   RunResult complete();
   RunResult loop(const SignalGuard& signals);
@@ -403,6 +407,36 @@ RunResult Run::State::complete() {
   return result;
 }
 
+// The kinetic-energy rule fired: test the state before calling it an equilibrium
+// (sim/stability.hpp). Unstable: the run goes on from the probe's end, with a row there.
+StopReason Run::State::test_stability(StopReason candidate) {
+  sim::Simulation& s = *sim;
+  const sim::StabilityProbe& probe = s.params().stability;
+  if (!probe.enabled || distributed) return candidate;
+  nlohmann::json tests = nlohmann::json::parse(meta.stability_tests_json);
+  const sim::ProbeOutcome o = sim::probe_stability(s, probe, tests.size());
+  tests.push_back({{"step", o.step},
+                   {"time_us", o.time_us},
+                   {"probe_steps", o.steps},
+                   {"probe_time_us", double(o.steps) * s.dt() / 1e-6},
+                   {"amplitude_rad", probe.amplitude},
+                   {"seed", probe.seed + tests.size()},
+                   {"E_total_before_kT", o.E_before_kT},
+                   {"E_total_after_kT", o.E_after_kT},
+                   {"writhe_before", o.writhe_before},
+                   {"writhe_after", o.writhe_after},
+                   {"stable", o.stable}});
+  meta.stability_tests_json = tests.dump();
+  say("ibrod: stability test at step " + std::to_string(o.step) + ": " + sim::describe(o) +
+      (o.stable ? "; an equilibrium" : "; not an equilibrium, the run goes on from there"));
+  if (o.stable) return candidate;
+  if (const std::string bad = sim::rod_problem(s.rod(), c.rod_rise_A); !bad.empty()) blow_up(bad);
+  last_row = observe_checked();
+  on_root([&] { files->row(last_row); });
+  check_link(last_row);
+  return s.at_end() ? StopReason::end_time : StopReason::none;
+}
+
 void Run::State::check_link(const sim::Observables& o) {
   const double drift = std::abs(o.link - result.initial.link);
   meta.max_link_drift = std::max(meta.max_link_drift, drift);
@@ -471,6 +505,7 @@ RunResult Run::State::loop(const SignalGuard& signals) {
         on_root([&] { files->row(last_row); });
         check_link(last_row);
         reason = s.stop_reason(last_row);
+        if (reason == StopReason::equilibrium) reason = test_stability(reason);
       }
       const bool stop = reason != StopReason::none;
       const bool frame_step = s.frame_due(stop);

@@ -58,6 +58,15 @@ std::string summary_json(const config::Config& c, const RunResult& r, const Chec
   j["checkpoint_step"] = r.checkpoint_step >= 0 ? nlohmann::ordered_json(r.checkpoint_step)
                                                 : nlohmann::ordered_json(nullptr);
   j["frames"] = frames;
+  j["stability_tests"] = nlohmann::ordered_json::parse(meta.stability_tests_json);
+  // an equilibrium is verified when the last stability test at the stop found it stable
+  if (stop_reason == "equilibrium") {
+    const auto tests = nlohmann::json::parse(meta.stability_tests_json);
+    j["equilibrium_verified"] = !tests.empty() && tests.back().value("stable", false) &&
+                                tests.back().value("step", std::int64_t(-1)) == r.steps;
+  } else {
+    j["equilibrium_verified"] = false;
+  }
   j["error"] = error.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(error);
   j["initial"] = observables_json(r.initial);
   j["final"] = observables_json(r.final);

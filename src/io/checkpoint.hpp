@@ -41,6 +41,9 @@ struct CheckpointMeta {
   double max_link_drift = 0;         ///< max |Lk − Lk(0)| over the output steps so far
   double wall_s = 0;                 ///< wall time of every segment of the run up to here, s
   std::int64_t resumes = 0;          ///< how many times the run was resumed
+  /// the stability tests so far (sim/stability.hpp), a JSON array of objects as summary.json
+  /// lists them
+  std::string stability_tests_json = "[]";
 };
 
 struct Checkpoint {
