@@ -90,6 +90,11 @@ std::string describe(const Config& c);
 std::string config_differences(const std::string& old_toml, const Config& now,
                                const std::string& source);
 
+/// Whether `now` differs from the configuration `old_toml` in a later time.t_end_us alone (the
+/// extension of a run: `--resume DIR --set time.t_end_us=T` needs no --force).
+bool only_end_time_extended(const std::string& old_toml, const Config& now,
+                            const std::string& source);
+
 /// Convert to internal units (g, Å, s) for the simulation.
 sim::SimParams to_params(const Config& c);
 

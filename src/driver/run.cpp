@@ -76,6 +76,7 @@ struct Run::State {
 
   std::optional<io::Checkpoint> checkpoint;  // the one to continue from, until it is applied
   bool config_changed = false;
+  bool extension = false;  // --resume with a later time.t_end_us alone
   // a run that stopped but was killed before its final files were all written: --resume only
   // writes them (the reason it stopped, from the checkpoint)
   bool complete_only = false;
@@ -176,12 +177,16 @@ void Run::State::open_checkpoint() {
                       std::to_string(c.rod_base_pairs) + ": incompatible, even with --force");
   const std::string diff = config::config_differences(ck.meta.config_toml, user, cp.string());
   config_changed = !diff.empty();
-  if (config_changed && !opt.force)
+  // a later t_end alone extends the run: the continuation is the uninterrupted longer run
+  extension = config_changed && config::only_end_time_extended(ck.meta.config_toml, user, cp.string());
+  if (extension)
+    say("ibrod: extending the run in " + dir.root().string() + " (" + diff + ")");
+  if (config_changed && !opt.force && !extension)
     throw ConfigError("resume: the configuration differs from the one " + cp.string() +
                       " was written with (" + diff +
                       "); pass --force to continue with the new values (the continued run is "
                       "then not the uninterrupted run of either configuration)");
-  if (config_changed)
+  if (config_changed && !extension)
     say("ibrod: warning: resuming with a changed configuration (--force): " + diff);
   // the time is state: a run never goes back (a shorter t_end than the checkpoint's time is an
   // error, not a run that stops "at step 60/50")
@@ -279,7 +284,15 @@ void Run::State::restore_state() {
 
 void Run::State::open_files() {
   on_root([&] {
-    files = std::make_unique<RunFiles>(dir, c, *sim, result.resumed_from, config_text, progress);
+    // extending a run that stopped at its end time: its last row and frame were written because
+    // it stopped, not by the schedule; the uninterrupted longer run has them only if on schedule
+    std::int64_t rows_to = result.resumed_from, frames_to = result.resumed_from;
+    if (extension && result.resumed_from > 0) {
+      const sim::OutputSchedule& out = sim->params().output;
+      if (rows_to % out.rows != 0) --rows_to;
+      if (out.frames > 0 && frames_to % out.frames != 0) --frames_to;
+    }
+    files = std::make_unique<RunFiles>(dir, c, *sim, rows_to, config_text, progress, frames_to);
   });
   // free space kept in hand: a checkpoint (written beside the previous one), a few frames
   // (H5MD + .vtp, ~300 B per point, + the .vti) and 16 MiB of slack

@@ -41,9 +41,10 @@ std::string summary_json(const config::Config& c, const RunResult& r,
 class RunFiles {
  public:
   // resume_step < 0: a fresh run (create everything); otherwise continue the files, dropping
-  // rows and frames after resume_step.
+  // rows after resume_step and frames after frame_step (−1: resume_step).
   RunFiles(const io::RunDir& dir, const config::Config& c, const sim::Simulation& sim,
-           std::int64_t resume_step, const std::string& config_text, Progress& progress)
+           std::int64_t resume_step, const std::string& config_text, Progress& progress,
+           std::int64_t frame_step = -1)
       : dir_(dir),
         ds_(c.rod_rise_A),
         vti_(c.output_fluid_vti),
@@ -59,10 +60,11 @@ class RunFiles {
     } else {
       io::write_file_atomic(ts, io::timeseries_up_to(try_read_text_file(ts).value_or(""),
                                              io::timeseries_header(), resume_step, ts.string()));
-      if (frames_on_) reopen_trajectory(dir.trajectory(), n, c.grid_box_A, resume_step,
+      if (frame_step < 0) frame_step = resume_step;
+      if (frames_on_) reopen_trajectory(dir.trajectory(), n, c.grid_box_A, frame_step,
                                         config_text, progress);
-      if (frames_on_) rod_pvd_.resume(resume_step);
-      if (frames_on_ && vti_) fluid_pvd_.resume(resume_step);
+      if (frames_on_) rod_pvd_.resume(frame_step);
+      if (frames_on_ && vti_) fluid_pvd_.resume(frame_step);
     }
     ts_ = std::fopen(ts.c_str(), "a");
     if (!ts_) throw RunError("output: cannot open " + ts.string() + ": " + io::io_error_text(errno));

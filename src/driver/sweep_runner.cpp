@@ -141,7 +141,15 @@ SweepReport run_sweep(const Sweep& sw, const SweepOptions& opt) {
   fs::create_directories(sweep_dir.configs(), ec);
   fs::create_directories(sweep_dir.logs(), ec);
   if (ec) throw RunError("sweep: cannot create '" + sweep_dir.logs().string() + "': " + ec.message());
-  if (opt.rank == 0) write_file_atomic(sweep_dir.points(), points_csv(sw));
+  if (opt.only_point < 0) {
+    if (opt.rank == 0) write_file_atomic(sweep_dir.points(), points_csv(sw));
+  } else if (!fs::exists(sweep_dir.points(), ec)) {
+    // the tasks of a job array start together: whichever writes it, it is the same file
+    try {
+      write_file_atomic(sweep_dir.points(), points_csv(sw));
+    } catch (const RunError&) {
+    }
+  }
   const std::string binary = opt.binary.empty() ? self_exe() : opt.binary;
   const int jobs = std::max(1, opt.jobs);
   const int ranks = std::max(1, opt.ranks);
@@ -164,7 +172,9 @@ SweepReport run_sweep(const Sweep& sw, const SweepOptions& opt) {
   };
   std::vector<Todo> todo;
   for (const SweepPoint& pt : sw.points) {
-    if (int(pt.index % std::size_t(ranks)) != opt.rank) continue;
+    if (opt.only_point >= 0 ? pt.index != std::size_t(opt.only_point)
+                            : int(pt.index % std::size_t(ranks)) != opt.rank)
+      continue;
     ++rep.points;
     const fs::path dir = sweep_dir.run(pt.name);
     const std::string config_text = to_toml(pt.config);

@@ -43,6 +43,7 @@ struct SweepOptions {
   int jobs = 1;                       ///< `ibrod run` processes at a time (per rank)
   std::string binary;                 ///< the ibrod to spawn ("": /proc/self/exe)
   int rank = 0, ranks = 1;            ///< this rank runs points with index % ranks == rank
+  long only_point = -1;               ///< ≥ 0: run this point alone (a job array's task)
   bool handle_signals = true;         ///< SIGINT/SIGTERM: pass on to the runs, wait, return
   std::FILE* log = stdout;            ///< progress lines (nullptr: silent)
 };

@@ -146,3 +146,10 @@ TEST(Cli, CheckPrintsDerivedQuantities) {
                         "time steps", "memory estimate", "ring radius r0            = 324.68"})
     EXPECT_THAT(r.output, HasSubstr(s));
 }
+
+TEST(Cli, VersionNamesTheVersionCommitBuildAndMpi) {
+  const Result r = sh("--version");
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(std::regex_search(r.output, std::regex(R"(^ibrod \d+\.\d+\.\d+ \(git \w+, \w+ build, MPI (yes|no)\))")))
+      << r.output;
+}

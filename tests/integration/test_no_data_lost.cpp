@@ -210,3 +210,35 @@ TEST(DiskFull, BeforeTheFirstCheckpointTheAdviceIsOverwriteAndItWorks) {
   EXPECT_EQ(again.code, 0) << again.output;
   fs::remove_all(d);
 }
+
+TEST(Extension, ALaterEndTimeAloneNeedsNoForceAndEqualsTheUninterruptedLongerRun) {
+  const fs::path d = fresh_dir("extend");
+  config::Config c = long_config();
+  c.time_t_end_us = 0.05;  // 500 steps: not a multiple of the rows (every 20: yes) or frames (40)
+  c.output_every_steps = 30;
+  const fs::path short_cfg = write_config(d, c, "short.toml");
+  c.time_t_end_us = 0.09;
+  const fs::path long_cfg = write_config(d, c, "long.toml");
+  ASSERT_EQ(run_ibrod({"run", long_cfg.string(), "-o", (d / "ref").string()}, d / "ref.log").code,
+            0);
+  ASSERT_EQ(run_ibrod({"run", short_cfg.string(), "-o", (d / "ext").string()}, d / "a.log").code,
+            0);
+  const Exit e = run_ibrod({"run", "--resume", (d / "ext").string(), "--set",
+                            "time.t_end_us=0.09"},
+                           d / "b.log");
+  ASSERT_EQ(e.code, 0) << e.output;
+  EXPECT_THAT(e.output, HasSubstr("extending the run"));
+  EXPECT_EQ(read_file(d / "ext" / "timeseries.csv"), read_file(d / "ref" / "timeseries.csv"));
+  EXPECT_EQ(read_file(d / "ext" / "final_state.csv"), read_file(d / "ref" / "final_state.csv"));
+  const io::H5mdSeries a = io::read_h5md_series(d / "ext" / "trajectory.h5", "position");
+  const io::H5mdSeries b = io::read_h5md_series(d / "ref" / "trajectory.h5", "position");
+  EXPECT_EQ(a.step, b.step);
+  EXPECT_EQ(a.value, b.value);
+  // another change still needs --force
+  const Exit other = run_ibrod({"run", "--resume", (d / "ext").string(), "--set",
+                                "time.t_end_us=0.1", "--set", "solvent.salt_M=0.05"},
+                               d / "c.log");
+  EXPECT_EQ(other.code, 2) << other.output;
+  EXPECT_THAT(other.output, HasSubstr("--force"));
+  fs::remove_all(d);
+}

@@ -146,11 +146,12 @@ TEST_F(Restart, DamagedOrForeignCheckpointsAreRefused) {
   EXPECT_EQ(e.code, 2) << e.output;
   EXPECT_THAT(e.output, HasSubstr("corrupt"));
 
-  // another configuration: refused, unless forced; another grid: refused even when forced
+  // another configuration: refused, unless forced (a later t_end alone is an extension, which
+  // needs no --force: test_no_data_lost.cpp); another grid: refused even when forced
   put(good);
-  e = resume({"--set", "time.t_end_us=0.07"});
+  e = resume({"--set", "solvent.salt_M=0.05"});
   EXPECT_EQ(e.code, 2) << e.output;
-  EXPECT_THAT(e.output, HasSubstr("time.t_end_us: 0.06 → 0.07"));
+  EXPECT_THAT(e.output, HasSubstr("solvent.salt_M: 0.1 → 0.05"));
   EXPECT_THAT(e.output, HasSubstr("--force"));
   e = resume({"--set", "grid.n=32", "--force"});
   EXPECT_EQ(e.code, 2) << e.output;

@@ -256,3 +256,35 @@ TEST(SweepRun, APointWrittenByAnotherProcessIsNotStartedAndNotCountedFinished) {
   EXPECT_NE(driver::point_state(point0), driver::PointState::running);
   fs::remove_all(d);
 }
+
+TEST(SweepRun, PointKRunsThatPointAloneAndListNumbersThem) {
+  // a scheduler's job array: `ibrod sweep SWEEP.toml --point K` per task
+  const fs::path d = fresh_dir("sweep_point");
+  std::ofstream(d / "sweep.toml") << tiny_sweep();
+  const driver::Sweep sw = driver::load_sweep(d / "sweep.toml");
+  const fs::path root = d / "out";
+  const Exit list = run_ibrod({"sweep", (d / "sweep.toml").string(), "-o", root.string(), "--list"},
+                              d / "list.log");
+  ASSERT_EQ(list.code, 0) << list.output;
+  EXPECT_THAT(list.output, ::testing::HasSubstr("   2  " + sw.points[2].name));
+  const Exit one = run_ibrod({"sweep", (d / "sweep.toml").string(), "-o", root.string(),
+                              "--point", "2"},
+                             d / "one.log");
+  ASSERT_EQ(one.code, 0) << one.output;
+  for (std::size_t i = 0; i < sw.points.size(); ++i)
+    EXPECT_EQ(driver::point_state(root / sw.points[i].name),
+              i == 2 ? driver::PointState::finished : driver::PointState::fresh)
+        << sw.points[i].name;
+  // again: skipped as finished; a point that does not exist is refused
+  const Exit again = run_ibrod({"sweep", (d / "sweep.toml").string(), "-o", root.string(),
+                                "--point", "2"},
+                               d / "again.log");
+  EXPECT_EQ(again.code, 0);
+  EXPECT_THAT(again.output, ::testing::HasSubstr("1 finished, 0 to run"));
+  const Exit bad = run_ibrod({"sweep", (d / "sweep.toml").string(), "-o", root.string(),
+                              "--point", "4"},
+                             d / "bad.log");
+  EXPECT_EQ(bad.code, 2) << bad.output;
+  EXPECT_THAT(bad.output, ::testing::HasSubstr("--point 4"));
+  fs::remove_all(d);
+}
