@@ -24,6 +24,7 @@ namespace driver = ibrod::driver;
 
 struct ConfigArgs {
   std::string config_path;
+  bool config_given = false;  ///< CONFIG was on the command line (perhaps as "")
   std::vector<std::string> sets;
 };
 
@@ -37,6 +38,10 @@ struct BenchArgs : ConfigArgs {
 };
 
 cfg::Config resolve(const ConfigArgs& a) {
+  // `ibrod run ""` is not `ibrod run`: an empty path is refused, not read as "defaults"
+  if (a.config_given && a.config_path.empty())
+    throw ibrod::ConfigError("config: cannot read file '': the path is empty (omit CONFIG for "
+                             "the built-in reference run)");
   cfg::Config c = cfg::load_config(a.config_path);
   for (const auto& s : a.sets) cfg::apply_override(c, s);
   cfg::validate(c);
@@ -44,7 +49,8 @@ cfg::Config resolve(const ConfigArgs& a) {
 }
 
 void add_config_args(CLI::App* cmd, ConfigArgs& a) {
-  cmd->add_option("config", a.config_path, "TOML config (default: the built-in reference run)");
+  cmd->add_option("config", a.config_path, "TOML config (default: the built-in reference run)")
+      ->each([&a](const std::string&) { a.config_given = true; });
   cmd->add_option("--set", a.sets, "override one key: section.key=value (repeatable)");
 }
 
@@ -79,6 +85,8 @@ int run_main(RunArgs a) {
     opt.fftw_wisdom = a.wisdom;
     opt.rank = world.rank;
     opt.ranks = world.size;
+    // the memory a run needs against what this process may allocate, before any of it is
+    cfg::check_memory(c, world.size);
     const driver::RunResult r = driver::run(c, opt);
     if (r.signal != 0 && world.rank == 0) {
       std::fprintf(stderr,
@@ -97,6 +105,12 @@ int check_main(const ConfigArgs& a) {
     const cfg::Config c = resolve(a);
     std::printf("# resolved configuration\n%s\n# derived quantities\n%s",
                 cfg::describe(c).c_str(), cfg::derived_report(c).c_str());
+    // a config may be meant for a larger machine: `check` warns where `run` would refuse
+    try {
+      cfg::check_memory(c);
+    } catch (const ibrod::ConfigError& e) {
+      std::printf("# warning: `ibrod run` here would refuse: %s\n", e.what());
+    }
     return 0;
   } catch (const std::exception& e) {
     return ibrod::app::report_error(e);
@@ -107,6 +121,7 @@ int bench_main(const BenchArgs& a) {
   try {
     cfg::Config c = resolve(a);
     if (a.threads > 0) c.run_threads = a.threads;
+    cfg::check_memory(c);
     driver::print_bench(c, driver::bench(c, a.steps), stdout);
     return 0;
   } catch (const std::exception& e) {

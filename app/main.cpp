@@ -6,7 +6,8 @@
 //   ibrod analyze DIR | render DIR [--time T] [--views ...] | sweep SWEEP.toml [-j K]
 // Each subcommand lives in its own cmd_*.cpp and runs from its CLI11 callback, ending the parse
 // with CLI::RuntimeError(status). Exit status: 0 success, 2 invalid input (config, arguments,
-// output directory, unusable checkpoint), 3 the run failed (blow-up, I/O such as a full disk),
+// output directory, unusable checkpoint, more memory than allowed), 3 the run failed (blow-up,
+// I/O such as a full disk, out of memory),
 // 4 some points of a sweep failed, 128 + N stopped by signal N (SIGINT 130, SIGTERM 143) after
 // writing a checkpoint, 1 anything else.
 #include <CLI/CLI.hpp>
