@@ -127,7 +127,7 @@ class RunFiles {
       return;
     }
     try {
-      h5_ = io::H5mdWriter::reopen(path, n, last, config_text);
+      h5_ = io::H5mdWriter::reopen(path, n, box_A, last, config_text);
     } catch (const RunError& e) {
       // a run killed in the middle of an HDF5 write can leave the file unreadable: keep it for
       // inspection and start a new one, rather than refuse to resume
