@@ -109,6 +109,10 @@ bool only_end_time_extended(const std::string& old_toml, const Config& now,
 /// Convert to internal units (g, Å, s) for the simulation.
 sim::SimParams to_params(const Config& c);
 
+/// What `ibrod check` warns of (the run is allowed): a grid spacing larger than the hard core,
+/// a box that leaves the ring's periodic images within a few Debye lengths. One sentence each.
+std::vector<std::string> check_warnings(const Config& c);
+
 /// Derived quantities for `ibrod check`: h, c, Δs, r0, 1/κ, Bjerrum length, steps, memory.
 std::string derived_report(const Config& c);
 
