@@ -46,7 +46,8 @@ void add_analysis_commands(CLI::App& app) {
   auto a = std::make_shared<AnalyzeArgs>();
   auto* analyze = app.add_subcommand(
       "analyze", "add the time-series analysis (writhe convergence, relaxation time τ, transient "
-                 "states, power law) to DIR/summary.json; see docs/analysis.md");
+                 "states, power law) and the shape of the final state (with --frames of every "
+                 "frame) to DIR/summary.json; see docs/analysis.md");
   analyze->add_option("dir", a->dir, "run directory (written by ibrod run)")->required();
   analyze->add_option("--delta", a->opt.writhe_delta,
                       "band |Wr − Wr(∞)| of the writhe convergence time")
@@ -56,10 +57,20 @@ void add_analysis_commands(CLI::App& app) {
                       "largest |residual| of ln E_K in a fit window (0.02: 2 %)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  analyze->add_flag("-q,--quiet", a->quiet, "print nothing on success");
+  analyze->add_flag("--frames", a->opt.every_frame,
+                    "also the shape of every frame of DIR/trajectory.h5 (summary.json shape_frames)");
+  analyze->add_option("--contact-distance", a->opt.contact_distance_A,
+                      "contact distance d_c in Å (default: D + 3 Debye lengths of config.toml)")
+      ->check(CLI::PositiveNumber);
+  analyze->add_option("--tau-window", a->opt.tau_window_us, "window of τ(t) in µs")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  analyze->add_flag("-q,--quiet", a->quiet, "print nothing on success (warnings still go to stderr)");
   analyze->callback([a] {
     finish([&] {
       const auto result = ibrod::analysis::analyze_run(a->dir, a->opt);
+      for (const auto& w : result.warnings)
+        std::fprintf(stderr, "ibrod analyze: warning: %s: %s\n", a->dir.c_str(), w.c_str());
       if (!a->quiet) std::printf("%s\n", ibrod::analysis::analysis_json(result, a->opt).c_str());
     });
   });
