@@ -172,12 +172,15 @@ std::vector<LocalRelaxation> local_relaxation_times(std::span<const double> t,
   std::vector<LocalRelaxation> out;
   if (t.empty()) return out;
   const double t0 = t.front();
+  // samples grouped by their window index (computed once per sample, so rounding at a window's
+  // edge cannot stall the loop)
+  auto window_of = [&](std::size_t j) { return std::floor((t[j] - t0) / width); };
   std::size_t i = 0;
   while (i < t.size()) {
-    const auto k = std::floor((t[i] - t0) / width);
+    const double k = window_of(i);
     const double a = t0 + k * width, b = a + width;
     std::vector<double> x, y;
-    for (; i < t.size() && t[i] < b; ++i)
+    for (; i < t.size() && window_of(i) == k; ++i)
       if (kinetic[i] > 0 && std::isfinite(kinetic[i])) {
         x.push_back(t[i]);
         y.push_back(std::log(kinetic[i]));
