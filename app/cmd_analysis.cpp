@@ -2,8 +2,14 @@
 // analysis/frames.hpp.
 #include "cmd_analysis.hpp"
 
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <exception>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <string>
@@ -34,9 +40,48 @@ std::string join(const std::vector<std::string>& v) {
   return s;
 }
 
+/// python/ibrod_report.py: $IBROD_REPORT_SCRIPT, else beside the source tree of a build directory
+/// (build/app/ibrod → python/), else installed beside the binary (../share/ibrod/).
+std::filesystem::path report_script() {
+  namespace fs = std::filesystem;
+  if (const char* env = std::getenv("IBROD_REPORT_SCRIPT")) return env;
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec)
+    for (const fs::path& p : {exe.parent_path() / "../../python/ibrod_report.py",
+                              exe.parent_path() / "../share/ibrod/ibrod_report.py"})
+      if (fs::exists(p)) return fs::weakly_canonical(p);
+  throw ibrod::ConfigError(
+      "ibrod report: python/ibrod_report.py not found (set IBROD_REPORT_SCRIPT to its path)");
+}
+
 }  // namespace
 
 void add_analysis_commands(CLI::App& app) {
+  // ---- report: the Python report, called the same way (docs/analysis.md)
+  auto* report = app.add_subcommand(
+      "report", "write the report of a sweep (tables, figures, contact sheet) with "
+                "python/ibrod_report.py: ibrod report RUN_DIR... -o REPORT_DIR [--frames]; the "
+                "binary is passed as --ibrod, so runs are analysed first");
+  report->prefix_command();  // every argument goes to the script
+  report->callback([report] {
+    finish([&] {
+      const std::string script = report_script().string();
+      std::error_code ec;
+      const std::string self = std::filesystem::read_symlink("/proc/self/exe", ec).string();
+      std::vector<std::string> args{"/usr/bin/python3", script};
+      for (const auto& r : report->remaining()) args.push_back(r);
+      if (!ec) args.insert(args.end(), {"--ibrod", self});
+      std::vector<char*> argv;
+      for (auto& a : args) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      std::fflush(stdout);
+      ::execv(argv[0], argv.data());
+      throw ibrod::RunError(std::string("ibrod report: cannot run /usr/bin/python3: ") +
+                            std::strerror(errno));
+    });
+  });
+
   // ---- analyze
   struct AnalyzeArgs {
     std::string dir;

@@ -246,11 +246,10 @@ json to_json(const Analysis& a, const AnalyzeOptions& opt) {
   const ShapeAnalysis& sh = a.shapes;
   j["shape"] = sh.final_shape ? shape_json(sh.final_shape->shape, sh.final_shape->time_us)
                               : json(nullptr);
-  if (!sh.frames.empty()) {
-    json fr = json::array();
-    for (const auto& f : sh.frames) fr.push_back(shape_json(f.shape, f.time_us));
-    j["shape_frames"] = fr;
-  }
+  // null without --frames, so that an earlier analysis's frames do not outlive a new one
+  json fr = opt.every_frame ? json::array() : json(nullptr);
+  for (const auto& f : sh.frames) fr.push_back(shape_json(f.shape, f.time_us));
+  j["shape_frames"] = fr;
   json contacts{{"distance_A", sh.contact_distance_A}};
   if (sh.contacts.time_us.empty()) {
     contacts["source"] = nullptr;

@@ -143,6 +143,12 @@ class PlotsAndReport(unittest.TestCase):
         self.assertFalse(os.path.isdir(os.path.join(self.b, "render")))
         sh(PYTHON, REPORT, self.a, self.b, "-o", rep, "--ibrod", BINARY)
         self.assertTrue(any(f.startswith("rod_oblique_t") for f in os.listdir(os.path.join(self.b, "render"))))
+        # `ibrod report` is the same script, with the binary as --ibrod
+        rep2 = os.path.join(self.tmp, "report2")
+        sh(BINARY, "report", self.a, self.b, "-o", rep2)
+        with open(os.path.join(rep2, "report.md")) as f:
+            self.assertIn("## Relaxation time", f.read())
+        self.assertNotEqual(sh(BINARY, "report", check=False).returncode, 0)  # no run: usage
 
 
 if __name__ == "__main__":
