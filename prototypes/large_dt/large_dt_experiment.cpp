@@ -50,6 +50,7 @@ int main(int argc, char** argv) {
   ip.krylov_tol = std::stod(kv["tol"]);
   ip.jacobian_every = std::stoi(kv["jac_every"]);
   ip.gauss_newton = kv["K"] != "full";
+  ip.stiffness_fd = kv["K"] == "fd";
   ip.steric_implicit = kv["steric_implicit"] == "1";
   ip.velocity_form = kv["form"] != "force";
   std::unique_ptr<integrate::ImplicitStepper> imp;
@@ -169,5 +170,11 @@ int main(int argc, char** argv) {
       scheme.c_str(), dt * 1e9, ip.mobility_scale, steps, blown, solves,
       steps ? double(iters) / steps : 0.0, notconv, E_rise, maxdisp, wall,
       steps ? 1e3 * wall / steps : 0.0, err, steps ? res_sum / steps : 0.0, ctl.rejections(), dt_min_used * 1e9);
+  if (imp) {
+    const auto& tm = imp->timings();
+    std::printf("TIMINGS_ms_per_step forces=%.3f stiffness=%.3f factorize=%.3f local_solve=%.3f "
+                "stokes=%.3f\n", 1e3 * tm.forces / steps, 1e3 * tm.stiffness / steps,
+                1e3 * tm.factorize / steps, 1e3 * tm.local_solve / steps, 1e3 * tm.stokes / steps);
+  }
   return blown ? 1 : 0;
 }

@@ -1,6 +1,7 @@
 #include "integrate/implicit.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -126,6 +127,49 @@ void ImplicitStepper::mobility(std::span<const Vec3> X, std::span<const Vec3> F,
 Eigen::SparseMatrix<double> ImplicitStepper::stiffness(const rod::RodState& s) {
   const int n = s.size();
   const rod::RodParams& rp = st_.params().rod;
+  if (p_.gauss_newton && !p_.stiffness_fd) {
+    // Gauss–Newton with the small-strain strain Jacobian of half point h (between k and k+1,
+    // triad D_h = [D¹ D² D³], X′ = (X_{k+1} − X_k)/Δs), MODEL §4 step 2 linearised:
+    //   δΓ_i = D^i·(δX_{k+1} − δX_k)/Δs + ½ (D^i × X′)·(δθ_k + δθ_{k+1})
+    //   δΩ_i = D^i·(δθ_{k+1} − δθ_k)/Δs
+    // (a common rotation leaves Γ unchanged; the half-point triad turns by the mean of its two
+    // ends'). K = Δs Σ_h J_hᵀ C J_h, C = diag(b1, b2, b3, a1, a2, a3): symmetric positive
+    // semi-definite, O(n). tests/integration/test_implicit.cpp compares it with the
+    // finite-difference Gauss–Newton K.
+    std::vector<Eigen::Triplet<double>> trip;
+    trip.reserve(std::size_t(n) * 4 * 36 + 4096);
+    using Mat6 = Eigen::Matrix<double, 6, 6>;
+    Eigen::Matrix<double, 6, 1> c;
+    c << rp.b.x(), rp.b.y(), rp.b.z(), rp.a.x(), rp.a.y(), rp.a.z();
+    for (int h = 0; h < n; ++h) {
+      const int h1 = (h + 1) % n;
+      const Mat3 Dh = rod::half_point_triad(s.D[h], s.D[h1]);
+      const Vec3 xp = (s.X[h1] - s.X[h]) / rp.ds;
+      Mat3 G;  // rows (D^i × X′)ᵀ
+      for (int i = 0; i < 3; ++i) G.row(i) = Dh.col(i).cross(xp).transpose();
+      Mat6 JL = Mat6::Zero(), JR = Mat6::Zero();  // ∂(Γ, Ω)/∂q_h, ∂(Γ, Ω)/∂q_{h+1}
+      JL.block<3, 3>(0, 0) = -Dh.transpose() / rp.ds;
+      JR.block<3, 3>(0, 0) = Dh.transpose() / rp.ds;
+      JL.block<3, 3>(0, 3) = 0.5 * G;
+      JR.block<3, 3>(0, 3) = 0.5 * G;
+      JL.block<3, 3>(3, 3) = -Dh.transpose() / rp.ds;
+      JR.block<3, 3>(3, 3) = Dh.transpose() / rp.ds;
+      const int idx[2] = {h, h1};
+      const Mat6* J[2] = {&JL, &JR};
+      for (int a = 0; a < 2; ++a)
+        for (int b = 0; b < 2; ++b) {
+          const Mat6 blk = rp.ds * J[a]->transpose() * c.asDiagonal() * (*J[b]);
+          for (int r = 0; r < 6; ++r)
+            for (int q = 0; q < 6; ++q)
+              trip.emplace_back(6 * idx[a] + r, 6 * idx[b] + q, blk(r, q));
+        }
+    }
+    contacts_ = p_.steric_implicit ? add_steric_stiffness(st_.params().steric, s.X, trip) : 0;
+    Eigen::SparseMatrix<double> K(6 * n, 6 * n);
+    K.setFromTriplets(trip.begin(), trip.end());
+    K.makeCompressed();
+    return K;
+  }
   const std::vector<int> col = colouring(n);
   const int ncol = *std::max_element(col.begin(), col.end()) + 1;
   pert_ = s;
@@ -219,20 +263,39 @@ Eigen::SparseMatrix<double> ImplicitStepper::stiffness(const rod::RodState& s) {
 
 void ImplicitStepper::factorize(double dt) {
   // M_loc = β diag(m_t I, m_r I)
-  VectorXd mloc(6 * n_);
+  mloc_.resize(6 * n_);
   for (int k = 0; k < n_; ++k) {
-    mloc.segment<3>(6 * k).setConstant(p_.mobility_scale * m_t_);
-    mloc.segment<3>(6 * k + 3).setConstant(p_.mobility_scale * m_r_);
+    mloc_.segment<3>(6 * k).setConstant(p_.mobility_scale * m_t_);
+    mloc_.segment<3>(6 * k + 3).setConstant(p_.mobility_scale * m_r_);
+  }
+  const bool contacts_changed = contacts_ > 0 || pattern_contacts_ > 0;
+  if (p_.gauss_newton) {
+    // K symmetric positive semi-definite: I + Δt M_loc K = M_loc (M_loc⁻¹ + Δt K), and
+    // S = M_loc⁻¹ + Δt K is symmetric positive definite: sparse Cholesky (AMD ordering)
+    Eigen::SparseMatrix<double> S = dt * K_;
+    for (int i = 0; i < 6 * n_; ++i) S.coeffRef(i, i) += 1.0 / mloc_[i];
+    S.makeCompressed();
+    if (!pattern_ready_ || S.nonZeros() != pattern_nnz_ || contacts_changed) {
+      llt_.analyzePattern(S);
+      pattern_ready_ = true;
+      pattern_nnz_ = S.nonZeros();
+      pattern_contacts_ = contacts_;
+    }
+    llt_.factorize(S);
+    if (llt_.info() != Eigen::Success)
+      throw std::runtime_error("ImplicitStepper: the local implicit system is not positive");
+    lu_dt_ = dt;
+    return;
   }
   // velocity form: A = I + Δt M_loc K (row scaling); force form: I + Δt K M_loc (columns)
   Eigen::SparseMatrix<double> A =
-      p_.velocity_form ? Eigen::SparseMatrix<double>(mloc.asDiagonal() * K_)
-                       : Eigen::SparseMatrix<double>(K_ * mloc.asDiagonal());
+      p_.velocity_form ? Eigen::SparseMatrix<double>(mloc_.asDiagonal() * K_)
+                       : Eigen::SparseMatrix<double>(K_ * mloc_.asDiagonal());
   A *= dt;
   for (int i = 0; i < 6 * n_; ++i) A.coeffRef(i, i) += 1.0;
   A.makeCompressed();
   // the band along the rod is fixed; steric contacts add and remove entries
-  if (!pattern_ready_ || A.nonZeros() != pattern_nnz_ || contacts_ > 0 || pattern_contacts_ > 0) {
+  if (!pattern_ready_ || A.nonZeros() != pattern_nnz_ || contacts_changed) {
     lu_.analyzePattern(A);
     pattern_ready_ = true;
     pattern_nnz_ = A.nonZeros();
@@ -244,7 +307,18 @@ void ImplicitStepper::factorize(double dt) {
   lu_dt_ = dt;
 }
 
+Eigen::VectorXd ImplicitStepper::local_solve(const Eigen::VectorXd& v) const {
+  if (!p_.gauss_newton) return lu_.solve(v);
+  // velocity form: (I + Δt M_loc K) x = v ⇔ S x = M_loc⁻¹ v;
+  // force form: (I + Δt K M_loc) x = v ⇔ S (M_loc x) = v
+  if (p_.velocity_form) return llt_.solve(VectorXd(v.cwiseQuotient(mloc_)));
+  return VectorXd(llt_.solve(v)).cwiseQuotient(mloc_);
+}
+
 namespace {
+double now() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
 bool same_state(const rod::RodState& a, const rod::RodState& b) {
   return a.X.size() == b.X.size() && std::equal(a.X.begin(), a.X.end(), b.X.begin()) &&
          std::equal(a.D.begin(), a.D.end(), b.D.begin());
@@ -305,7 +379,9 @@ int gmres(const Apply& apply, const Prec& prec, const VectorXd& b, VectorXd& x, 
 
 const ImplicitStepper::Cached& ImplicitStepper::forces_at(const rod::RodState& s) {
   if (!has_cur_ || !same_state(cur_.q, s)) {
+    const double t0 = now();
     cur_.E = st_.compute_forces(s);
+    timings_.forces += now() - t0;
     cur_.q = s;
     cur_.F = st_.forces();
     cur_.T = st_.torques();
@@ -334,20 +410,32 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
 
   if (local || p_.krylov_max_iter > 0) {
     if (steps_since_jacobian_ == 0 || K_.rows() != 6 * n) {
+      const double t0 = now();
       K_ = stiffness(s);
+      timings_.stiffness += now() - t0;
       info.jacobian_refreshed = true;
       lu_dt_ = -1;
     }
     steps_since_jacobian_ = (steps_since_jacobian_ + 1) % p_.jacobian_every;
   }
-  if (local && lu_dt_ != dt) factorize(dt);
+  if (local && lu_dt_ != dt) {
+    const double t0 = now();
+    factorize(dt);
+    timings_.factorize += now() - t0;
+  }
   auto precondition = [&](const VectorXd& v) -> VectorXd {
-    return local ? VectorXd(lu_.solve(v)) : v;
+    if (!local) return v;
+    const double t0 = now();
+    VectorXd x = local_solve(v);
+    timings_.local_solve += now() - t0;
+    return x;
   };
   std::vector<Vec3> aF(n), aT(n), aU(n), aW(n);
   auto apply_mobility = [&](const VectorXd& g) {  // M g: one Stokes solve
     unpack(g, aF, aT);
+    const double t0 = now();
     mobility(s.X, aF, aT, aU, aW);
+    timings_.stokes += now() - t0;
     ++info.fluid_solves;
     VectorXd u;
     pack(aU, aW, u);

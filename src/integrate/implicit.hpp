@@ -24,6 +24,7 @@
 // Finally X ← X + δ_X, D ← R(δ_θ) D (Rodrigues): the link is conserved as long as the rod does
 // not pass through itself, and the triads stay orthonormal.
 #include <Eigen/Sparse>
+#include <Eigen/SparseCholesky>
 #include <Eigen/SparseLU>
 #include <memory>
 #include <vector>
@@ -40,6 +41,8 @@ struct ImplicitParams {
   int jacobian_every = 1;        ///< steps between refreshes of K (≥ 1; K at qⁿ when refreshed)
   bool velocity_form = true;     ///< (I + Δt M_loc K) u = M F (true) or (I + Δt K M_loc) g = F
   bool gauss_newton = true;      ///< K = Δs Σ Jᵀ C J (positive semi-definite) instead of −∂F/∂q
+  bool stiffness_fd = false;     ///< Gauss–Newton K by finite differences (else small-strain
+                                 ///< analytic strain Jacobian, O(n))
   bool steric_implicit = true;   ///< add the steric contacts' stiffness to K
   double fd_dx = 1e-4;           ///< finite-difference step of K in positions, Å
   double fd_dtheta = 1e-5;       ///< ... and in rotation vectors, rad
@@ -57,6 +60,11 @@ struct ImplicitStepInfo {
   double energy_after = 0;      ///<   and at qⁿ⁺¹, g Å² s⁻²
   bool finite = true;           ///< qⁿ⁺¹ is finite
   bool jacobian_refreshed = false;
+};
+
+/// Wall time spent in the parts of ImplicitStepper::step, accumulated, s.
+struct ImplicitTimings {
+  double forces = 0, stiffness = 0, factorize = 0, local_solve = 0, stokes = 0;
 };
 
 class ImplicitStepper {
@@ -80,10 +88,12 @@ class ImplicitStepper {
   void mobility(std::span<const Vec3> X, std::span<const Vec3> F, std::span<const Vec3> T,
                 std::span<Vec3> U, std::span<Vec3> W);
 
-  /// The elastic stiffness K = −∂(F, T)/∂(X, θ) at s by central finite differences over a
-  /// colouring of the rod (F_k, T_k depend on points k−1..k+1 only), [6n × 6n], per point
-  /// (x, y, z, θx, θy, θz); units g s⁻², g Å s⁻², g Å² s⁻². Plus the stiffness of the steric
-  /// contacts (positions only; see implicit.cpp).
+  /// The elastic stiffness at s, [6n × 6n], per point (x, y, z, θx, θy, θz); units g s⁻²,
+  /// g Å s⁻², g Å² s⁻²: the Gauss–Newton K = Δs Σ_h J_hᵀ C J_h with the small-strain analytic
+  /// strain Jacobian (default), or by central finite differences over a colouring of the rod
+  /// (F_k, T_k depend on points k−1..k+1 only): Gauss–Newton (stiffness_fd) or the full
+  /// −∂(F, T)/∂(X, θ) (gauss_newton = false). Plus the stiffness of the steric contacts
+  /// (positions only; see implicit.cpp).
   Eigen::SparseMatrix<double> stiffness(const rod::RodState& s);
 
   double self_mobility_translation() const { return m_t_; }  ///< Å s⁻¹ per g Å s⁻²
@@ -93,7 +103,8 @@ class ImplicitStepper {
   const std::vector<Vec3>& velocities() const { return U_; }          ///< [n] δX/Δt, Å s⁻¹
   const std::vector<Vec3>& angular_velocities() const { return W_; }  ///< [n] δθ/Δt, s⁻¹
   Stepper& base() { return st_; }
-  int contacts() const { return contacts_; }  ///< steric segment contacts in the latest K
+  int contacts() const { return contacts_; }
+  const ImplicitTimings& timings() const { return timings_; }  ///< steric segment contacts in the latest K
 
  private:
   Stepper& st_;
@@ -102,13 +113,17 @@ class ImplicitStepper {
   double m_t_ = 0, m_r_ = 0;   // self mobilities
   double scale_t_ = 1;         // GMRES weight of torques: 1/ℓ, ℓ = √(m_t/m_r)
   Eigen::SparseMatrix<double> K_;
-  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu_;
+  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu_;             // full K (not symmetric)
+  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> llt_;        // Gauss–Newton K
+  Eigen::VectorXd mloc_;                                         // diagonal of M_loc
+  Eigen::VectorXd local_solve(const Eigen::VectorXd& v) const;   // (I + Δt M_loc K)⁻¹ v
   bool pattern_ready_ = false;
   Eigen::Index pattern_nnz_ = 0;
   int contacts_ = 0, pattern_contacts_ = 0;  // steric contacts in K, in the analysed pattern
   double lu_dt_ = -1;          // dt of the current factorisation (−1: none)
   long steps_since_jacobian_ = 0;
   StepEnergies last_;
+  ImplicitTimings timings_;
   rod::RodWork work_;
   std::vector<Vec3> U_, W_, Fa_, Ta_, Fb_, Tb_;
   rod::RodState pert_;

@@ -64,7 +64,7 @@ TEST(Implicit, FirstOrderConvergenceTowardASmallStepExplicitReference) {
     r.run(0.4e-9 / (1 << i), T);
     err[i] = max_distance(r.rod, ref.rod);
   }
-  // measured 9.9, 4.3, 2.3 Å: ratios 2.3, 1.9
+  // measured 9.3, 4.0, 2.1 Å: ratios 2.3, 1.9 (analytic Gauss–Newton K)
   EXPECT_LT(err[0], 20.0);
   for (int i = 0; i < 2; ++i) {
     const double ratio = err[i] / err[i + 1];
@@ -139,6 +139,7 @@ TEST(Implicit, TwentyTimesTheExplicitLimitThroughCollapseAndContact) {
   EXPECT_GT(spacing, 3.3);
   EXPECT_LT(spacing, 3.7);
   // the point of it: a mean step of at least 5× the explicit limit, with steps at the maximum
+  // (measured: 101 steps and 5 rejected trials for 150 ns, mean 1.5 ns = 10× the limit)
   EXPECT_GT(t / steps, 5 * kExplicitLimit) << steps << " steps";
   EXPECT_GT(at_max, 5);
 }
