@@ -38,7 +38,10 @@ struct ImplicitParams {
   double mobility_scale = 2.0;   ///< β: M_loc = β × the kernel's self mobility (≥ 0)
   int krylov_max_iter = 0;       ///< GMRES iterations after the IMEX guess (0: scheme (2))
   double krylov_tol = 1e-2;      ///< relative residual of (1) at which GMRES stops
-  int jacobian_every = 1;        ///< steps between refreshes of K (≥ 1; K at qⁿ when refreshed)
+  /// trial steps between refreshes of K and of the factorisation (≥ 1; K at qⁿ when refreshed;
+  /// also refreshed when Δt changes the factorisation anyway). 4: at the 64³ reference
+  /// 3.9 against 7.3 ms per step, the same accuracy (docs/large_dt.md)
+  int jacobian_every = 4;
   bool velocity_form = true;     ///< (I + Δt M_loc K) u = M F (true) or (I + Δt K M_loc) g = F
   bool gauss_newton = true;      ///< K = Δs Σ Jᵀ C J (positive semi-definite) instead of −∂F/∂q
   bool stiffness_fd = false;     ///< Gauss–Newton K by finite differences (else small-strain
@@ -82,6 +85,9 @@ class ImplicitStepper {
   ImplicitStepInfo step(rod::RodState& s, double dt);
   /// Puts s back to qⁿ of the latest step (a rejected trial step); at most once per step.
   void undo(rod::RodState& s);
+  /// The next step refreshes K (a resumed run and the run it continues then step alike: call it
+  /// where a checkpoint is written and after one is read).
+  void refresh_jacobian() { steps_since_jacobian_ = 0; }
 
   /// (U, W) = M (F, T) at positions X: one Stokes solve (MODEL §4 spreading and interpolation,
   /// ρ dropped). Å s⁻¹, s⁻¹.
