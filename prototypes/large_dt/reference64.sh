@@ -12,3 +12,4 @@ for dt in 2 4.4; do
   $X $R scheme=imex beta=8 adaptive=1 dmax=1.92 etol=1e-6 dt_ns=$dt t_end_ns=$T out_ns=20 ref=/tmp/ref64_X.txt > $D/ref64_implicit_$dt.txt
 done
 grep -h SUMMARY $D/ref64_*.txt
+/usr/bin/python3 $D/plot_reference64.py
