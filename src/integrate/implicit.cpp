@@ -525,4 +525,19 @@ ImplicitStepInfo step_adaptive(ImplicitStepper& stepper, rod::RodState& s, Adapt
   }
 }
 
+ImplicitIntegrator::ImplicitIntegrator(Stepper& stepper, const ImplicitParams& p,
+                                       const AdaptiveDtParams& a)
+    : stepper_(stepper, p), ctl_(a) {}
+
+double ImplicitIntegrator::advance(rod::RodState& s, double max_dt) {
+  double dt = 0;
+  info_ = step_adaptive(stepper_, s, ctl_, max_dt, &dt, &rejected_);
+  return dt;
+}
+
+void ImplicitIntegrator::restore(const State& st) {
+  ctl_ = AdaptiveDt(ctl_.params(), st.next_dt, st.accepted_in_a_row);
+  stepper_.refresh_jacobian();
+}
+
 }  // namespace ibrod::integrate

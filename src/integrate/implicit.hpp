@@ -155,4 +155,36 @@ ImplicitStepInfo step_adaptive(ImplicitStepper& stepper, rod::RodState& s, Adapt
 /// The controller's view of a step.
 StepOutcome outcome(const ImplicitStepInfo& info);
 
+/// The implicit scheme as a time integrator (`time.scheme = "implicit"`): an ImplicitStepper
+/// driven by an AdaptiveDt. Its evolving state, besides the rod, is the controller's next Δt and
+/// its count of accepted steps in a row (checkpoint them with state() and put them back with
+/// restore(); K is then refreshed at the next step, so call restore() — or refresh() — at the
+/// same point of the uninterrupted run as well, e.g. whenever a checkpoint is written).
+class ImplicitIntegrator {
+ public:
+  struct State {
+    double next_dt = 0;          ///< s
+    int accepted_in_a_row = 0;
+  };
+  ImplicitIntegrator(Stepper& stepper, const ImplicitParams& p, const AdaptiveDtParams& a);
+
+  /// One accepted step of at most max_dt (s; e.g. the time left to t_end): returns its Δt.
+  double advance(rod::RodState& s, double max_dt);
+  const ImplicitStepInfo& last_info() const { return info_; }
+  int last_rejections() const { return rejected_; }
+  long rejections() const { return ctl_.rejections(); }
+
+  State state() const { return {ctl_.dt(), ctl_.accepted_in_a_row()}; }
+  void restore(const State& st);
+  void refresh() { stepper_.refresh_jacobian(); }
+  ImplicitStepper& stepper() { return stepper_; }
+  const AdaptiveDt& controller() const { return ctl_; }
+
+ private:
+  ImplicitStepper stepper_;
+  AdaptiveDt ctl_;
+  ImplicitStepInfo info_;
+  int rejected_ = 0;
+};
+
 }  // namespace ibrod::integrate
