@@ -1,4 +1,5 @@
-// `ibrod analyze` and `ibrod render` (cmd_analysis.hpp); the work is in io/analyze.hpp.
+// `ibrod analyze` and `ibrod render` (cmd_analysis.hpp); the work is in analysis/analyze.hpp and
+// analysis/frames.hpp.
 #include "cmd_analysis.hpp"
 
 #include <cstdio>
@@ -10,7 +11,7 @@
 
 #include "core/error.hpp"
 #include "exit_status.hpp"
-#include "io/analyze.hpp"
+#include "analysis/frames.hpp"
 #include "render/render.hpp"
 
 namespace {
@@ -39,7 +40,7 @@ void add_analysis_commands(CLI::App& app) {
   // ---- analyze
   struct AnalyzeArgs {
     std::string dir;
-    ibrod::io::AnalyzeOptions opt;
+    ibrod::analysis::AnalyzeOptions opt;
     bool quiet = false;
   };
   auto a = std::make_shared<AnalyzeArgs>();
@@ -58,15 +59,15 @@ void add_analysis_commands(CLI::App& app) {
   analyze->add_flag("-q,--quiet", a->quiet, "print nothing on success");
   analyze->callback([a] {
     finish([&] {
-      const auto result = ibrod::io::analyze_run(a->dir, a->opt);
-      if (!a->quiet) std::printf("%s\n", ibrod::io::analysis_json(result, a->opt).c_str());
+      const auto result = ibrod::analysis::analyze_run(a->dir, a->opt);
+      if (!a->quiet) std::printf("%s\n", ibrod::analysis::analysis_json(result, a->opt).c_str());
     });
   });
 
   // ---- render
   struct RenderArgs {
     std::string dir, size = "800x800";
-    ibrod::io::RenderOptions opt;
+    ibrod::analysis::RenderOptions opt;
   };
   auto r = std::make_shared<RenderArgs>();
   auto* render = app.add_subcommand(
@@ -83,8 +84,8 @@ void add_analysis_commands(CLI::App& app) {
   render->add_option("--size", r->size, "image size WxH in pixels")->capture_default_str();
   render->callback([r] {
     finish([&] {
-      ibrod::io::parse_size(r->size, r->opt.width, r->opt.height);
-      ibrod::io::render_run(r->dir, r->opt, stdout);
+      ibrod::analysis::parse_size(r->size, r->opt.width, r->opt.height);
+      ibrod::analysis::render_run(r->dir, r->opt, stdout);
     });
   });
 }

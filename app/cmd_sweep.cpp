@@ -1,4 +1,4 @@
-// `ibrod sweep` (cmd_sweep.hpp); the work is in io/sweep.hpp.
+// `ibrod sweep` (cmd_sweep.hpp); the work is in driver/sweep_file.hpp and driver/sweep_runner.hpp.
 #include "cmd_sweep.hpp"
 
 #include <cstdio>
@@ -9,8 +9,8 @@
 
 #include "core/error.hpp"
 #include "exit_status.hpp"
-#include "io/mpi_env.hpp"
-#include "io/sweep.hpp"
+#include "driver/mpi_env.hpp"
+#include "driver/sweep_runner.hpp"
 
 namespace {
 
@@ -23,16 +23,16 @@ struct SweepArgs {
 int sweep_main(const SweepArgs& a) {
   namespace fs = std::filesystem;
   // MPI only under a launcher; the ranks share the points, each spawns plain `ibrod run`s
-  const ibrod::io::mpi::World world = ibrod::io::mpi::init(nullptr, nullptr);
+  const ibrod::driver::mpi::World world = ibrod::driver::mpi::init(nullptr, nullptr);
   struct Finalize {
-    const ibrod::io::mpi::World& w;
-    ~Finalize() { ibrod::io::mpi::finalize(w); }
+    const ibrod::driver::mpi::World& w;
+    ~Finalize() { ibrod::driver::mpi::finalize(w); }
   } finalize{world};
   const bool root = world.rank == 0;
   int status = 0;
   try {
-    const ibrod::io::Sweep sw = ibrod::io::load_sweep(a.file);
-    ibrod::io::SweepOptions opt;
+    const ibrod::driver::Sweep sw = ibrod::driver::load_sweep(a.file);
+    ibrod::driver::SweepOptions opt;
     opt.output_root = !a.output.empty()          ? fs::path(a.output)
                       : !sw.output_root.empty() ? fs::path(sw.output_root)
                                                 : fs::path(fs::path(a.file).stem());
@@ -40,21 +40,21 @@ int sweep_main(const SweepArgs& a) {
       if (root)
         for (const auto& pt : sw.points)
           std::printf("%-40s %s\n", pt.name.c_str(),
-                      ibrod::io::to_string(ibrod::io::point_state(opt.output_root / pt.name)));
+                      ibrod::driver::to_string(ibrod::driver::point_state(opt.output_root / pt.name)));
       return 0;
     }
     opt.jobs = a.jobs;
     opt.rank = world.rank;
     opt.ranks = world.size;
-    const ibrod::io::SweepReport r = ibrod::io::run_sweep(sw, opt);
+    const ibrod::driver::SweepReport r = ibrod::driver::run_sweep(sw, opt);
     for (const auto& name : r.failed_names)
       std::fprintf(stderr, "ibrod: sweep: point %s failed\n", name.c_str());
     // collectives in the same order on every rank
-    const long long failed = ibrod::io::mpi::sum(r.failed);
-    const long long sig = ibrod::io::mpi::max(r.signal);
-    const long long points = ibrod::io::mpi::sum(r.points);
-    const long long completed = ibrod::io::mpi::sum(r.completed);
-    const long long skipped = ibrod::io::mpi::sum(r.skipped);
+    const long long failed = ibrod::driver::mpi::sum(r.failed);
+    const long long sig = ibrod::driver::mpi::max(r.signal);
+    const long long points = ibrod::driver::mpi::sum(r.points);
+    const long long completed = ibrod::driver::mpi::sum(r.completed);
+    const long long skipped = ibrod::driver::mpi::sum(r.skipped);
     if (world.size > 1 && root)
       std::printf("sweep: all ranks: %lld points, %lld finished now, %lld already finished, %lld "
                   "failed\n",

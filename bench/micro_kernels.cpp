@@ -1,5 +1,5 @@
 // Google Benchmark micro-benchmarks of the kernels of one time step (docs/performance.md).
-// Reference system: MODEL §1 (64³ grid, 725 Å box, 600 points), built through io::to_params so
+// Reference system: MODEL §1 (64³ grid, 725 Å box, 600 points), built through config::to_params so
 // that every parameter is the one a run uses. Threads: OMP_NUM_THREADS (FFTW and OpenMP loops).
 //   ./build/bench/ibrod_microbench --benchmark_min_time=0.2
 #include <benchmark/benchmark.h>
@@ -13,9 +13,9 @@
 #include "diagnostics/topology.hpp"
 #include "fluid/advection.hpp"
 #include "fluid/navier_stokes.hpp"
-#include "ib/coupling.hpp"
+#include "ib/plane_coupler.hpp"
 #include "interactions/interactions.hpp"
-#include "io/config.hpp"
+#include "config/config.hpp"
 #include "rod/rod.hpp"
 #include "sim/simulation.hpp"
 
@@ -23,8 +23,8 @@ using namespace ibrod;
 
 namespace {
 
-io::Config reference(int grid_n = 64, int points = 600, double salt = 0.1) {
-  io::Config c;
+config::Config reference(int grid_n = 64, int points = 600, double salt = 0.1) {
+  config::Config c;
   c.grid_n = grid_n;
   c.rod_base_pairs = points;
   c.solvent_salt_M = salt;
@@ -66,7 +66,7 @@ struct CouplingFixture {
   std::vector<double> grid;
   std::vector<Vec3> F, T, U, W;
   explicit CouplingFixture(int n_grid, int points)
-      : p(io::to_params(reference(n_grid, points))),
+      : p(config::to_params(reference(n_grid, points))),
         s(ring(p)),
         cp(p.stepper.grid, p.stepper.kernel_width),
         grid(3 * p.stepper.grid.size()),
@@ -124,7 +124,7 @@ BENCHMARK(BM_PlaneCoupling)
     ->UseRealTime();
 
 void BM_ElasticForces(benchmark::State& st) {
-  const auto p = io::to_params(reference(64, int(st.range(0))));
+  const auto p = config::to_params(reference(64, int(st.range(0))));
   const auto s = ring(p);
   rod::RodWork w;
   w.resize(s.size());
@@ -136,7 +136,7 @@ BENCHMARK(BM_ElasticForces)->Arg(600)->Arg(6000)->Unit(benchmark::kMicrosecond)-
 
 // range(0): salt in mM (100 = 0.1 M, 1 = 0.001 M: Debye length 96 Å, most pairs interact)
 void BM_Electrostatics(benchmark::State& st) {
-  const auto p = io::to_params(reference(64, 600, st.range(0) * 1e-3));
+  const auto p = config::to_params(reference(64, 600, st.range(0) * 1e-3));
   const auto s = ring(p);
   interactions::Electrostatics el(p.stepper.electro, s.size());
   std::vector<Vec3> F(s.size());
@@ -146,7 +146,7 @@ void BM_Electrostatics(benchmark::State& st) {
 BENCHMARK(BM_Electrostatics)->Arg(100)->Arg(1)->Unit(benchmark::kMicrosecond)->UseRealTime();
 
 void BM_Steric(benchmark::State& st) {
-  const auto p = io::to_params(reference());
+  const auto p = config::to_params(reference());
   const auto s = ring(p);
   interactions::Steric sr(p.stepper.steric, s.size());
   std::vector<Vec3> F(s.size());
@@ -157,7 +157,7 @@ BENCHMARK(BM_Steric)->Unit(benchmark::kMicrosecond)->UseRealTime();
 struct FluidFixture {
   fluid::FluidSolver fl;
   explicit FluidFixture(int n)
-      : fl(io::to_params(reference(n)).stepper.grid, io::to_params(reference(n)).stepper.fluid,
+      : fl(config::to_params(reference(n)).stepper.grid, config::to_params(reference(n)).stepper.fluid,
            omp_get_max_threads(), true) {
     for (int c = 0; c < 3; ++c) fill_random(fl.velocity(c), fl.grid().size(), 1e6, 5 + c);
   }
@@ -201,7 +201,7 @@ void BM_FluidStep(benchmark::State& st) {
 BENCHMARK(BM_FluidStep)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_Writhe(benchmark::State& st) {
-  const auto p = io::to_params(reference(64, int(st.range(0))));
+  const auto p = config::to_params(reference(64, int(st.range(0))));
   const auto s = ring(p);
   for (auto _ : st) benchmark::DoNotOptimize(diag::writhe(s.X));
 }

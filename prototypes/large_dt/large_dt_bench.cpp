@@ -12,23 +12,23 @@
 #include <string>
 
 #include "integrate/implicit.hpp"
-#include "io/config.hpp"
+#include "config/config.hpp"
 
 using namespace ibrod;
 
 int main(int argc, char** argv) {
   std::map<std::string, std::string> kv{
       {"dt_max_ns", "2"}, {"implicit_ns", "200"}, {"explicit_steps", "300"}, {"beta", "8"}};
-  io::Config cfg;
-  io::apply_override(cfg, "run.threads=2");
+  config::Config cfg;
+  config::apply_override(cfg, "run.threads=2");
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const auto eq = a.find('=');
     if (eq == std::string::npos) return std::fprintf(stderr, "bad argument %s\n", a.c_str()), 2;
-    if (a.substr(0, eq).find('.') != std::string::npos) io::apply_override(cfg, a);
+    if (a.substr(0, eq).find('.') != std::string::npos) config::apply_override(cfg, a);
     else kv[a.substr(0, eq)] = a.substr(eq + 1);
   }
-  const sim::SimParams p = io::to_params(cfg);
+  const sim::SimParams p = config::to_params(cfg);
   using clock = std::chrono::steady_clock;
   auto secs = [](clock::time_point a) {
     return std::chrono::duration<double>(clock::now() - a).count();

@@ -1,7 +1,7 @@
 // Issue 14 experiment: one ring, one scheme, one Δt; prints a time series and a summary line
 // (docs/large_dt.md has the commands and the numbers).
 //   large_dt_experiment scheme=explicit|stokes|imex|krylov dt_ns=… t_end_ns=… [key=value …]
-// Any other key=value that contains a '.' is passed to the config (io::apply_override), e.g.
+// Any other key=value that contains a '.' is passed to the config (config::apply_override), e.g.
 // grid.n=32 rod.base_pairs=150. Keys of this program: scheme, dt_ns, t_end_ns, out_ns, beta,
 // kiter, tol, jac_every, save=FILE (final X), ref=FILE (max |X − X_ref| at the end).
 #include <chrono>
@@ -15,7 +15,7 @@
 #include "diagnostics/topology.hpp"
 #include "integrate/adaptive_dt.hpp"
 #include "integrate/implicit.hpp"
-#include "io/config.hpp"
+#include "config/config.hpp"
 
 using namespace ibrod;
 
@@ -23,17 +23,17 @@ int main(int argc, char** argv) {
   std::map<std::string, std::string> kv{{"scheme", "imex"}, {"dt_ns", "1"},   {"t_end_ns", "200"},
                                         {"out_ns", "20"},   {"beta", "2"},    {"kiter", "10"},
                                         {"tol", "1e-2"},    {"jac_every", "1"}, {"K", "gn"}, {"steric_implicit", "1"}, {"adaptive", "0"}, {"form", "velocity"}, {"energy_every_step", "0"}, {"dmax", "2"}, {"etol", "1e-3"}};
-  io::Config cfg;
+  config::Config cfg;
   // the experiment's ring: 32³, h as at the reference (11.33 Å), 150 bp, ΔLk = 3, 0.1 M
   for (const char* s : {"grid.n=32", "grid.box_A=362.5", "rod.base_pairs=150",
                         "rod.excess_link=3", "run.threads=1", "run.fftw_measure=false"})
-    io::apply_override(cfg, s);
+    config::apply_override(cfg, s);
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const auto eq = a.find('=');
     if (eq == std::string::npos) return std::fprintf(stderr, "bad argument %s\n", a.c_str()), 2;
     const std::string k = a.substr(0, eq);
-    if (k.find('.') != std::string::npos) io::apply_override(cfg, a);
+    if (k.find('.') != std::string::npos) config::apply_override(cfg, a);
     else kv[k] = a.substr(eq + 1);
   }
   const std::string scheme = kv["scheme"];
@@ -41,7 +41,7 @@ int main(int argc, char** argv) {
   const double t_end = std::stod(kv["t_end_ns"]) * 1e-9;
   const double out = std::stod(kv["out_ns"]) * 1e-9;
   cfg.time_dt_ns = std::stod(kv["dt_ns"]);
-  sim::SimParams p = io::to_params(cfg);
+  sim::SimParams p = config::to_params(cfg);
   rod::RodState rod = rod::twisted_circle(p.stepper.rod, p.circle);
   integrate::Stepper st(p.stepper);
   integrate::ImplicitParams ip;

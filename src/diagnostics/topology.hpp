@@ -9,8 +9,8 @@ namespace ibrod::diag {
 
 /// Writhe of the closed polygon X_0 … X_{n−1} (X_n = X_0), exact for polygons (the Gauss double
 /// integral as a sum of signed solid angles of segment pairs): Wr = (1/2π) Σ_{i<j, not adjacent}
-/// Ω_ij. O(n²), OpenMP over rows; the result does not depend on the thread count. About 3 ms for
-/// n = 600 on one core.
+/// Ω_ij. O(n²), OpenMP over rows; the result does not depend on the thread count (its cost:
+/// BM_Writhe in docs/performance.md).
 double writhe(std::span<const Vec3> X);
 
 /// Twist of the ribbon (X, d1) about the closed polygon X, in turns: the total rotation of d1

@@ -101,16 +101,14 @@ void rhs_plane(int n, double h, const int* next, const int* prev,
     const double* xm[3] = {uxm[0] + oc, uxm[1] + oc, uxm[2] + oc};
     const double* yp[3] = {uc[0] + oyp, uc[1] + oyp, uc[2] + oyp};
     const double* ym[3] = {uc[0] + oym, uc[1] + oym, uc[2] + oym};
-    double* rr[3] = {r[0] + oc, r[1] + oc, r[2] + oc};
-    advect_row(n, c, xp, xm, yp, ym, rr, a, b4, assign);
+    double* r_row[3] = {r[0] + oc, r[1] + oc, r[2] + oc};
+    advect_row(n, c, xp, xm, yp, ym, r_row, a, b4, assign);
   }
 }
 
-namespace {
-
-void rhs_pass(const GridSpec& grid, const int* next, const int* prev,
-              std::array<const double*, 3> u, std::array<double*, 3> r, double a, double b,
-              int threads, bool assign) {
+void accumulate_rhs(const GridSpec& grid, const int* next, const int* prev,
+                    std::array<const double*, 3> u, std::array<double*, 3> r, double a, double b,
+                    int threads) {
   const int n = grid.n;
   const std::size_t plane = std::size_t(n) * n;
   const double h = grid.h();
@@ -120,23 +118,8 @@ void rhs_pass(const GridSpec& grid, const int* next, const int* prev,
 #pragma omp parallel for num_threads(threads) schedule(static)
   for (int i = 0; i < n; ++i) {
     std::array<double*, 3> ri{r[0] + i * plane, r[1] + i * plane, r[2] + i * plane};
-    rhs_plane(n, h, next, prev, at(u, i), at(u, next[i]), at(u, prev[i]), ri, a, b, assign);
+    rhs_plane(n, h, next, prev, at(u, i), at(u, next[i]), at(u, prev[i]), ri, a, b, false);
   }
-}
-
-
-}  // namespace
-
-void accumulate_rhs(const GridSpec& grid, const int* next, const int* prev,
-                    std::array<const double*, 3> u, std::array<double*, 3> r, double a, double b,
-                    int threads) {
-  rhs_pass(grid, next, prev, u, r, a, b, threads, false);
-}
-
-void assign_rhs(const GridSpec& grid, const int* next, const int* prev,
-                std::array<const double*, 3> u, std::array<double*, 3> r, double a, double b,
-                int threads) {
-  rhs_pass(grid, next, prev, u, r, a, b, threads, true);
 }
 
 }  // namespace ibrod::fluid::detail

@@ -43,10 +43,4 @@ void accumulate_rhs(const GridSpec& grid, const int* next, const int* prev,
                     std::array<const double*, 3> u, std::array<double*, 3> r, double a, double b,
                     int threads);
 
-/// As accumulate_rhs, but overwrites: r_c = a·u_c − b·S_h(u)_c. r's previous contents are never
-/// read, so the caller needs no zeroing pass (FluidSolver::begin_step).
-void assign_rhs(const GridSpec& grid, const int* next, const int* prev,
-                std::array<const double*, 3> u, std::array<double*, 3> r, double a, double b,
-                int threads);
-
 }  // namespace ibrod::fluid::detail

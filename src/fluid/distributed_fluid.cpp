@@ -7,18 +7,16 @@
 #include <fftw3-mpi.h>
 #include <mpi.h>
 #include <omp.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
-#include <filesystem>
 #include <mutex>
 #include <new>
-#include <numbers>
 
 #include "fluid/advection.hpp"
 #include "fluid/fftw_wisdom.hpp"
+#include "fluid/spectral.hpp"
 #endif
 
 namespace ibrod::fluid {
@@ -52,8 +50,7 @@ fftw_plan as_plan(void* p) { return static_cast<fftw_plan>(p); }
 void init_fftw_mpi() {
   static std::once_flag once;
   std::call_once(once, [] {
-    if (fftw_init_threads() == 0)
-      throw std::runtime_error("DistributedFluid: fftw_init_threads failed");
+    init_fftw_threads();
     fftw_mpi_init();
   });
 }
@@ -68,19 +65,11 @@ DistributedFluid::DistributedFluid(const GridSpec& grid, const FluidParams& para
   MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
   MPI_Comm_size(MPI_COMM_WORLD, &ranks_);
   // The same checks as FluidSolver; every rank sees the same arguments, so all throw alike.
-  if (grid.n < 4 || grid.n % 2 != 0)
-    throw std::invalid_argument("DistributedFluid: grid n must be even and >= 4, got " +
-                                std::to_string(grid.n));
+  detail::check_fluid_args("DistributedFluid", grid, params, threads);
   if (grid.n % ranks_ != 0)
     throw std::invalid_argument("DistributedFluid: the grid of n = " + std::to_string(grid.n) +
                                 " x-planes cannot be split evenly over " + std::to_string(ranks_) +
                                 " MPI ranks: the rank count must divide n");
-  if (!(grid.L > 0.0)) throw std::invalid_argument("DistributedFluid: box edge L must be > 0");
-  if (!(params.density > 0.0)) throw std::invalid_argument("DistributedFluid: density must be > 0");
-  if (!(params.dt > 0.0)) throw std::invalid_argument("DistributedFluid: dt must be > 0");
-  if (!(params.viscosity >= 0.0))
-    throw std::invalid_argument("DistributedFluid: viscosity must be >= 0");
-  if (threads < 0) throw std::invalid_argument("DistributedFluid: threads must be >= 0");
   threads_ = threads > 0 ? threads : std::max(1, omp_get_max_threads());
 
   const int n = grid_.n;
@@ -88,18 +77,7 @@ DistributedFluid::DistributedFluid(const GridSpec& grid, const FluidParams& para
   const int nzh = n / 2 + 1;
   plane_ = std::size_t(n) * n;
   detail::make_neighbour_tables(n, next_, prev_);
-  grad_symbol_.assign(n, 0.0);
-  lap_symbol_.assign(n, 0.0);
-  for (int k = 0; k <= n / 2; ++k) {  // as FluidSolver: exact zeros at k = 0, n/2, exact oddness
-    const double g = (k == 0 || k == n / 2) ? 0.0 : std::sin(2.0 * std::numbers::pi * k / n) / h;
-    const double s = std::sin(std::numbers::pi * k / n);
-    grad_symbol_[k] = g;
-    lap_symbol_[k] = 4.0 / (h * h) * s * s;
-    if (k > 0 && k < n / 2) {
-      grad_symbol_[n - k] = -g;
-      lap_symbol_[n - k] = lap_symbol_[k];
-    }
-  }
+  detail::make_spectral_symbols(n, h, grad_symbol_, lap_symbol_);
 
   init_fftw_mpi();
   // Complex dimensions n × n × (n/2+1), 3 interleaved components; x distributed in real space,
@@ -152,14 +130,7 @@ DistributedFluid::DistributedFluid(const GridSpec& grid, const FluidParams& para
   }
   if (plan_measure) {
     fftw_mpi_gather_wisdom(MPI_COMM_WORLD);  // rank 0 exports it (run driver, cache)
-    if (!cache.empty()) {
-      namespace fs = std::filesystem;
-      std::error_code ec;
-      fs::create_directories(fs::path(cache).parent_path(), ec);
-      const std::string tmp = cache + ".tmp." + std::to_string(::getpid());
-      if (export_wisdom(tmp)) fs::rename(tmp, cache, ec);
-      if (ec || fs::exists(tmp, ec)) fs::remove(tmp, ec);
-    }
+    if (!cache.empty()) save_wisdom_cache(cache);
   }
   // FFTW_MEASURE scribbles on the buffer: start from rest only afterwards
   std::fill(buf_, buf_ + 2 * alloc, 0.0);
@@ -260,7 +231,8 @@ void DistributedFluid::finish_step() {
 }
 
 void DistributedFluid::spectral_pass() {
-  // FluidSolver::spectral_pass on the transposed, interleaved layout: complex (jl, i, k, c) at
+  // the per-wavenumber solve of FluidSolver (solve_row, navier_stokes.cpp) on the transposed,
+  // interleaved layout: complex (jl, i, k, c) at
   // ((jl n + i)(n/2+1) + k) 3 + c, global y index y0 + jl, x index i, z index k.
   const int n = grid_.n;
   const int nzh = n / 2 + 1;
@@ -283,7 +255,7 @@ void DistributedFluid::spectral_pass() {
       const double gz = gs[k];
       const double g2 = gxy2 + gz * gz;
       // ĝ = 0 (every k_j ∈ {0, n/2}): no pressure, ĝ·r̂ = 0 exactly; DBL_MIN keeps every
-      // nonzero |ĝ|² bit-for-bit and the loop branch-free (see FluidSolver::spectral_pass)
+      // nonzero |ĝ|² bit-for-bit and the loop branch-free (see solve_row in navier_stokes.cpp)
       const double ig2 = 1.0 / (g2 + DBL_MIN);
       const double scale = norm / (inertia + mu * (lxy + ls[k]));
       double* q = rl + 6 * std::size_t(k);

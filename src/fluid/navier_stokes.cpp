@@ -2,33 +2,21 @@
 
 #include <fftw3.h>
 #include <omp.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
-#include <cstdlib>
-#include <filesystem>
-#include <mutex>
 #include <new>
-#include <numbers>
 #include <stdexcept>
 #include <string>
 
 #include "core/target_clones.hpp"
 #include "fluid/advection.hpp"
 #include "fluid/fftw_wisdom.hpp"
+#include "fluid/spectral.hpp"
 
 namespace ibrod::fluid {
 namespace {
-
-// fftw_init_threads must run once per process, before any threaded plan is made.
-void init_fftw_threads() {
-  static std::once_flag once;
-  std::call_once(once, [] {
-    if (fftw_init_threads() == 0) throw std::runtime_error("FluidSolver: fftw_init_threads failed");
-  });
-}
 
 fftw_plan as_plan(void* p) { return static_cast<fftw_plan>(p); }
 
@@ -36,84 +24,18 @@ fftw_plan as_plan(void* p) { return static_cast<fftw_plan>(p); }
 // multiple of 32 (FFTW's alignment) that puts the components' rows in different cache sets
 constexpr std::size_t kCompPad = 136;
 
-// Best effort throughout: a cache that cannot be read or written only costs planning time.
-void save_wisdom_cache(const std::string& path) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  fs::create_directories(fs::path(path).parent_path(), ec);
-  // write then rename: concurrent processes never see a half-written file
-  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-  if (export_wisdom(tmp)) fs::rename(tmp, path, ec);
-  if (ec || fs::exists(tmp, ec)) fs::remove(tmp, ec);
-}
-
-// Makes a set of plans with `make(flags)` (which returns false, having destroyed whatever it
-// made, if a plan fails). With FFTW_MEASURE, wisdom already in the process (a resumed run imports
-// its own first) wins; otherwise the on-disk cache, and only if that lacks these plans too,
-// FFTW_MEASURE, saved for next time.
-template <class Make>
-bool plan_with_wisdom(bool measure, unsigned flags, Make make);
-
-}  // namespace
-
-std::string wisdom_cache_path() {
-  if (const char* p = std::getenv("IBROD_FFTW_WISDOM_CACHE")) return p;  // "" disables
-  if (const char* x = std::getenv("XDG_CACHE_HOME"); x && *x)
-    return std::string(x) + "/ibrod/fftw-wisdom";
-  if (const char* h = std::getenv("HOME"); h && *h)
-    return std::string(h) + "/.cache/ibrod/fftw-wisdom";
-  return {};
-}
-
-namespace {
-template <class Make>
-bool plan_with_wisdom(bool measure, unsigned flags, Make make) {
-  if (!measure) return make(flags | FFTW_ESTIMATE);
-  flags |= FFTW_MEASURE;
-  if (make(flags | FFTW_WISDOM_ONLY)) return true;
-  const std::string cache = wisdom_cache_path();
-  if (!cache.empty()) import_wisdom(cache);
-  if (make(flags | FFTW_WISDOM_ONLY)) return true;
-  if (!make(flags)) return false;
-  if (!cache.empty()) save_wisdom_cache(cache);
-  return true;
-}
 }  // namespace
 
 FluidSolver::FluidSolver(const GridSpec& grid, const FluidParams& params, int threads,
                          bool plan_measure)
     : grid_(grid), params_(params) {
-  // Even n: the r2c half-spectrum and the Nyquist handling assume it; n ≥ 4 so that ±1 and ±2
-  // neighbours are distinct points.
-  if (grid.n < 4 || grid.n % 2 != 0)
-    throw std::invalid_argument("FluidSolver: grid n must be even and >= 4, got " +
-                                std::to_string(grid.n));
-  if (!(grid.L > 0.0)) throw std::invalid_argument("FluidSolver: box edge L must be > 0");
-  // ρ/Δt > 0 and μ ≥ 0 keep the implicit denominator ρ/Δt − μL̂ positive for every k.
-  if (!(params.density > 0.0)) throw std::invalid_argument("FluidSolver: density must be > 0");
-  if (!(params.dt > 0.0)) throw std::invalid_argument("FluidSolver: dt must be > 0");
-  if (!(params.viscosity >= 0.0))
-    throw std::invalid_argument("FluidSolver: viscosity must be >= 0");
-  if (threads < 0) throw std::invalid_argument("FluidSolver: threads must be >= 0");
+  detail::check_fluid_args("FluidSolver", grid, params, threads);
   threads_ = threads > 0 ? threads : std::max(1, omp_get_max_threads());
 
   const int n = grid_.n;
   const double h = grid_.h();
   detail::make_neighbour_tables(n, next_, prev_);
-  grad_symbol_.assign(n, 0.0);
-  lap_symbol_.assign(n, 0.0);
-  for (int k = 0; k <= n / 2; ++k) {
-    // Exact zeros at k = 0, n/2 and exact oddness sin(2π(n−k)/n) = −sin(2πk/n): the spectral
-    // multiplier is then exactly even in k, as the c2r transform assumes of a real field.
-    const double g = (k == 0 || k == n / 2) ? 0.0 : std::sin(2.0 * std::numbers::pi * k / n) / h;
-    const double s = std::sin(std::numbers::pi * k / n);
-    grad_symbol_[k] = g;
-    lap_symbol_[k] = 4.0 / (h * h) * s * s;
-    if (k > 0 && k < n / 2) {
-      grad_symbol_[n - k] = -g;
-      lap_symbol_[n - k] = lap_symbol_[k];
-    }
-  }
+  detail::make_spectral_symbols(n, h, grad_symbol_, lap_symbol_);
 
   // the k_z symbols once per double of the interleaved half spectrum (solve_row)
   grad_symbol2_.resize(2 * std::size_t(n / 2 + 1));
@@ -233,12 +155,6 @@ void FluidSolver::begin_step() {
 }
 
 void FluidSolver::step() { finish_step(); }
-
-void FluidSolver::step(const PlaneForcing& forcing) {
-  pass_rhs_planes(&forcing);
-  pass_pencils();
-  pass_inverse_planes();
-}
 
 void FluidSolver::step(const PlaneForcing& forcing, const PlaneSampler& sampler) {
   pass_rhs_planes(&forcing);

@@ -23,7 +23,7 @@ struct FluidParams {
   bool advection = true;     ///< include ρS_h(u); false gives the unsteady Stokes equations
 };
 
-/// A body force supplied one x-plane at a time (FluidSolver::step(const PlaneForcing&)), e.g. an
+/// A body force supplied one x-plane at a time (FluidSolver::step(forcing, sampler)), e.g. an
 /// immersed boundary's spreading: add_plane(i, plane) adds (+=) the force density (g Å⁻² s⁻²) of
 /// x-plane i to three arrays (components) of n·n values, layout j·n + k. It is called once per
 /// plane per step, concurrently for different planes.
@@ -52,7 +52,7 @@ class FluidSolver {
   /// threads: FFTW/OpenMP threads (0 = OpenMP default). plan_measure: FFTW_MEASURE (true) or
   /// FFTW_ESTIMATE (false; fast to plan, for tests). With FFTW_MEASURE, plans already in the
   /// process's wisdom (e.g. a resumed run's own, imported first) are used as they are; otherwise
-  /// the wisdom cache (wisdom_cache_path()) is imported, and if it lacks these plans they are
+  /// the wisdom cache (fluid/fftw_wisdom.hpp: wisdom_cache_path()) is imported, and if it lacks these plans they are
   /// measured and the cache rewritten. An unreadable or unwritable cache is ignored.
   FluidSolver(const GridSpec& grid, const FluidParams& params, int threads = 0,
               bool plan_measure = true);
@@ -81,9 +81,8 @@ class FluidSolver {
   /// Advance u by one step Δt with the current force density (MODEL §4). No allocation.
   void step();
   /// The same with the force density of `forcing` added (to force(), if that was written), plane
-  /// by plane while the right-hand side is assembled: the fast path, no grid-sized force pass.
-  void step(const PlaneForcing& forcing);
-  /// ... and with `sampler` reading each plane of uⁿ⁺¹ while it is in cache.
+  /// by plane while the right-hand side is assembled, and with `sampler` reading each plane of
+  /// uⁿ⁺¹ while it is in cache: the fast path, no grid-sized force pass.
   void step(const PlaneForcing& forcing, const PlaneSampler& sampler);
 
   /// The same step in two halves, for a caller that spreads its forces in between:
@@ -159,10 +158,5 @@ class FluidSolver {
                                      // implicit viscosity, 1/n³
   void solve_slice_stokes(int j);    // f̂ → û of the Stokes limit in place on the y-slice j
 };
-
-/// On-disk FFTW wisdom cache used by FluidSolver when plan_measure is set: $IBROD_FFTW_WISDOM_CACHE
-/// if set (empty: no cache), else $XDG_CACHE_HOME/ibrod/fftw-wisdom, else
-/// $HOME/.cache/ibrod/fftw-wisdom ("" if none of them is set).
-std::string wisdom_cache_path();
 
 }  // namespace ibrod::fluid

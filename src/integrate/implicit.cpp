@@ -92,7 +92,7 @@ int add_steric_stiffness(const interactions::StericParams& p, std::span<const Ve
 
 ImplicitStepper::ImplicitStepper(Stepper& stepper, const ImplicitParams& p)
     : st_(stepper), p_(p), n_(stepper.params().rod.n) {
-  if (st_.distributed())
+  if (st_.params().distributed)
     throw std::invalid_argument("ImplicitStepper: the fluid must not be distributed");
   if (!(p_.mobility_scale >= 0)) throw std::invalid_argument("ImplicitStepper: mobility_scale < 0");
   if (p_.krylov_max_iter < 0) throw std::invalid_argument("ImplicitStepper: krylov_max_iter < 0");

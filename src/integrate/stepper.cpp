@@ -1,5 +1,8 @@
 #include "integrate/stepper.hpp"
 
+#include <algorithm>
+#include <chrono>
+
 #include <omp.h>
 
 #include <algorithm>
@@ -45,7 +48,7 @@ Stepper::Stepper(const StepperParams& p)
   T_.resize(n);
   U_.resize(n);
   W_.resize(n);
-  if (dist_) UW_.resize(6 * std::size_t(n));
+  if (dist_) rank_sum_.resize(6 * std::size_t(n));
 }
 
 Stepper::~Stepper() = default;
@@ -59,19 +62,45 @@ fluid::FluidSolver* Stepper::serial_fluid() {
   return const_cast<fluid::FluidSolver*>(std::as_const(*this).serial_fluid());
 }
 
+// Adds the time since the previous mark to phase k (nothing without a StepPhaseTimes).
+class PhaseClock {
+ public:
+  explicit PhaseClock(StepPhaseTimes* t) : t_(t) {
+    if (t_) last_ = std::chrono::steady_clock::now();
+  }
+  void mark(int k) {
+    if (!t_) return;
+    const auto now = std::chrono::steady_clock::now();
+    t_->ms[k] += std::chrono::duration<double, std::milli>(now - last_).count();
+    last_ = now;
+  }
+
+ private:
+  StepPhaseTimes* t_;
+  std::chrono::steady_clock::time_point last_;
+};
+
 StepEnergies Stepper::compute_forces(const rod::RodState& s) {
+  PhaseClock none(nullptr);
+  return forces(s, none);
+}
+
+StepEnergies Stepper::forces(const rod::RodState& s, PhaseClock& clock) {
   std::fill(F_.begin(), F_.end(), Vec3::Zero());
   std::fill(T_.begin(), T_.end(), Vec3::Zero());
   StepEnergies e;
   e.elastic = rod::elastic_forces(p_.rod, s, work_, F_, T_);
+  clock.mark(0);
   // MODEL §3 sign convention: −∂E/∂X of every non-elastic potential goes to the fluid unchanged.
   if (p_.electro.enabled) e.electro = electro_.accumulate(s.X, F_);
   if (p_.steric.enabled) e.steric = steric_.accumulate(s.X, F_);
+  clock.mark(1);
   return e;
 }
 
-void Stepper::step(rod::RodState& s) {
-  last_ = compute_forces(s);
+void Stepper::step(rod::RodState& s, StepPhaseTimes* phases) {
+  PhaseClock clock(dist_ ? nullptr : phases);
+  forces(s, clock);
   if (dist_) {
     // the same step on this rank's x-slab; U, W are partial sums until summed over the ranks
     dist_->begin_step();
@@ -82,25 +111,36 @@ void Stepper::step(rod::RodState& s) {
     const std::size_t n = U_.size();
     for (std::size_t k = 0; k < n; ++k)
       for (int d = 0; d < 3; ++d) {
-        UW_[3 * k + d] = U_[k][d];
-        UW_[3 * (n + k) + d] = W_[k][d];
+        rank_sum_[3 * k + d] = U_[k][d];
+        rank_sum_[3 * (n + k) + d] = W_[k][d];
       }
-    dist_->sum_over_ranks(UW_.data(), UW_.size());
+    dist_->sum_over_ranks(rank_sum_.data(), rank_sum_.size());
     for (std::size_t k = 0; k < n; ++k)
       for (int d = 0; d < 3; ++d) {
-        U_[k][d] = UW_[3 * k + d];
-        W_[k][d] = UW_[3 * (n + k) + d];
+        U_[k][d] = rank_sum_[3 * k + d];
+        W_[k][d] = rank_sum_[3 * (n + k) + d];
       }
     rod::advance(s, U_, W_, p_.fluid.dt);
     return;
   }
   // fⁿ = spread(F, T) is added to r = ρuⁿ/Δt − ρS_h(uⁿ) plane by plane inside the fluid step
   // (MODEL §4), and U, W at Xⁿ are sampled from uⁿ⁺¹ plane by plane: the kernel weights are
-  // evaluated once, and no grid-sized pass is spent on either
+  // evaluated once, and no grid-sized pass is spent on either (FluidSolver::step's three passes,
+  // called one by one here so that the benchmark can time them)
   plane_coupler_.prepare(s.X, F_, T_);
-  fluid_->step(PlaneCouplerForcing(plane_coupler_), PlaneCouplerSampler(plane_coupler_));
+  clock.mark(2);
+  const PlaneCouplerForcing forcing(plane_coupler_);
+  const PlaneCouplerSampler sampler(plane_coupler_);
+  fluid_->pass_rhs_planes(&forcing);
+  clock.mark(3);
+  fluid_->pass_pencils();
+  clock.mark(4);
+  fluid_->pass_inverse_planes(&sampler);
+  clock.mark(5);
   plane_coupler_.finish_interpolation(U_, W_);
+  clock.mark(6);
   rod::advance(s, U_, W_, p_.fluid.dt);
+  clock.mark(7);
 }
 
 double Stepper::fluid_kinetic_energy() const {

@@ -24,7 +24,8 @@
 #include "core/grid.hpp"
 #include "fluid/distributed_fluid.hpp"
 #include "fluid/navier_stokes.hpp"
-#include "ib/coupling.hpp"
+#include "ib/coupler.hpp"
+#include "ib/plane_coupler.hpp"
 #include "interactions/interactions.hpp"
 #include "rod/rod.hpp"
 
@@ -43,8 +44,7 @@ struct StepperParams {
   bool distributed = false;
 };
 
-/// Potential energies at the force evaluation of the latest step (the state before the move),
-/// g Å² s⁻².
+/// Potential energies of the state whose forces compute_forces() evaluated, g Å² s⁻².
 struct StepEnergies {
   rod::ElasticEnergy elastic;
   double electro = 0;
@@ -69,29 +69,35 @@ struct PlaneCouplerSampler final : fluid::PlaneSampler {
   }
 };
 
+/// Wall time of each phase of the serial step, accumulated over the steps it is passed to
+/// (`ibrod bench`: the production step itself, timed phase by phase).
+struct StepPhaseTimes {
+  static constexpr int kCount = 8;
+  static constexpr const char* kNames[kCount] = {
+      "rod forces",        "pair forces",  "kernel weights",  "rhs+spread+2D FFT",
+      "x FFTs+solve",      "2D iFFT+interp.", "interp. sums", "update"};
+  double ms[kCount] = {};
+};
+
+class PhaseClock;
+
 class Stepper {
  public:
   explicit Stepper(const StepperParams& p);
   ~Stepper();
 
-  /// Advance rod and fluid by one Δt.
-  void step(rod::RodState& s);
+  /// Advance rod and fluid by one Δt. phases (serial fluid only): add each phase's wall time.
+  void step(rod::RodState& s, StepPhaseTimes* phases = nullptr);
 
-  /// Rod forces only (step 1): fills forces()/torques() and returns the energies.
+  /// Rod forces only (step 1): fills the point forces and torques and returns the energies.
   StepEnergies compute_forces(const rod::RodState& s);
 
   const StepperParams& params() const { return p_; }
-  /// The serial fluid solver (not distributed(); throws std::logic_error otherwise).
+  /// The serial fluid solver (throws std::logic_error when StepperParams::distributed).
   fluid::FluidSolver& fluid() { return *serial_fluid(); }
   const fluid::FluidSolver& fluid() const { return *serial_fluid(); }
-  /// The fluid shared by the MPI ranks (distributed() only, else nullptr).
-  fluid::DistributedFluid* distributed_fluid() { return dist_.get(); }
-  const fluid::DistributedFluid* distributed_fluid() const { return dist_.get(); }
-  bool distributed() const { return dist_ != nullptr; }
-  /// rank 0 of the distributed fluid, or the only process
-  bool root() const { return !dist_ || dist_->rank() == 0; }
 
-  // The fluid, whichever it is (collective calls when distributed():
+  // The fluid, whichever it is (collective calls when StepperParams::distributed:
   // every rank must make them in the same order).
   /// ½ρ Σ|u|² h³ of the whole grid, g Å² s⁻² (collective; the same bits on every rank)
   double fluid_kinetic_energy() const;
@@ -101,15 +107,14 @@ class Stepper {
   std::array<const double*, 3> whole_velocity(std::vector<double>& scratch) const;
   /// Sets the fluid velocity from the whole grid (every rank passes it; collective).
   void set_whole_velocity(std::array<const double*, 3> u);
-  const ib::Coupler& coupler() const { return coupler_; }
   ib::PlaneCoupler& plane_coupler() { return plane_coupler_; }
   interactions::Electrostatics& electrostatics() { return electro_; }
   interactions::Steric& steric() { return steric_; }
-  const StepEnergies& last_energies() const { return last_; }
-  const std::vector<Vec3>& forces() const { return F_; }    ///< [n] point forces, g Å s⁻²
-  const std::vector<Vec3>& torques() const { return T_; }   ///< [n] point torques, g Å² s⁻²
-  const std::vector<Vec3>& velocities() const { return U_; }         ///< [n] U, Å s⁻¹
-  const std::vector<Vec3>& angular_velocities() const { return W_; } ///< [n] W, s⁻¹
+  /// [n] point forces (g Å s⁻²) and torques (g Å² s⁻²) of the latest compute_forces() or step();
+  /// velocities U (Å s⁻¹) of the latest step() (the implicit scheme, issue 14, reads them)
+  const std::vector<Vec3>& forces() const { return F_; }
+  const std::vector<Vec3>& torques() const { return T_; }
+  const std::vector<Vec3>& velocities() const { return U_; }
 
  private:
   StepperParams p_;
@@ -120,10 +125,12 @@ class Stepper {
   interactions::Electrostatics electro_;
   interactions::Steric steric_;
   rod::RodWork work_;
+  // [n] point forces (g Å s⁻²), torques (g Å² s⁻²), velocities U (Å s⁻¹), angular
+  // velocities W (s⁻¹)
   std::vector<Vec3> F_, T_, U_, W_;
-  std::vector<double> UW_;  // distributed: U and W packed for the sum over ranks
-  StepEnergies last_;
+  std::vector<double> rank_sum_;  // distributed: [6n] U then W, packed for sum_over_ranks
   const fluid::FluidSolver* serial_fluid() const;
+  StepEnergies forces(const rod::RodState& s, PhaseClock& clock);
   fluid::FluidSolver* serial_fluid();
 };
 

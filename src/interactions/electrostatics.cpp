@@ -8,19 +8,20 @@
 
 namespace ibrod::interactions {
 
-double DebyeHuckel::energy(double d) const { return A * std::exp(-kappa * d) / d; }
-
-double DebyeHuckel::force_over_d(double d) const {
-  // −dE/dd = A e^{−κd}/d (1/d + κ), MODEL (2.19–2.22); divided by d for the vector form
-  const double inv = 1.0 / d;
-  return A * std::exp(-kappa * d) * inv * (inv + kappa) * inv;
-}
-
 DebyeHuckel debye_huckel(double charge_e, double dielectric, double salt_M) {
   DebyeHuckel law;
   law.A = charge_e * charge_e / (4 * std::numbers::pi * units::vacuum_permittivity * dielectric);
   law.kappa = units::debye_kappa(salt_M);
   return law;
+}
+
+ElectroParams electro_params(bool enabled, double charge_e, double dielectric, double salt_M,
+                             double cutoff_debye) {
+  ElectroParams p;
+  p.enabled = enabled;
+  p.law = debye_huckel(charge_e, dielectric, salt_M);
+  p.cutoff = p.law.kappa > 0 ? cutoff_debye / p.law.kappa : 0.0;
+  return p;
 }
 
 namespace {
@@ -29,13 +30,11 @@ namespace {
 /// subtracts it from fj (Newton's third law), returns the shifted pair energy.
 inline double pair(const DebyeHuckel& law, double e_shift, const Vec3& delta, double d2, Vec3& fi,
                    Vec3& fj) {
-  const double d = std::sqrt(d2);
-  const double inv = 1.0 / d;
-  const double e = law.A * std::exp(-law.kappa * d) * inv;  // A e^{−κd}/d
-  const Vec3 f = (e * (inv + law.kappa) * inv) * delta;
+  const DebyeHuckel::Terms t = law.eval(d2);
+  const Vec3 f = t.force_over_d * delta;
   fi += f;
   fj -= f;
-  return e - e_shift;
+  return t.energy - e_shift;
 }
 
 }  // namespace

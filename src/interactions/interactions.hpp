@@ -9,6 +9,7 @@
 // allocation after the first call at a given size), reduced in a fixed order, so results are
 // reproducible for a fixed thread count.
 #include <array>
+#include <cmath>
 #include <span>
 #include <vector>
 
@@ -53,13 +54,34 @@ struct CellScratch {
 };
 }  // namespace detail
 
-/// Screened Coulomb pair law: E(d) = A e^{−κd}/d, A = q²/(4π ε0 εw) (g Å³ s⁻²).
+/// Screened Coulomb pair law, MODEL (2.19–2.22): E(d) = A e^{−κd}/d, A = q²/(4π ε0 εw)
+/// (g Å³ s⁻²), −(dE/dd)/d = A e^{−κd}/d (1/d + κ)/d. The pair law of every Debye–Hückel sum
+/// (Electrostatics: the cell-list loop, the direct oracle, the energy); a small evaluator in the
+/// manner of HOOMD's EvaluatorPair, the loops over pairs written elsewhere.
 struct DebyeHuckel {
   double A = 0;      ///< q²/(4π ε0 εw), g Å³ s⁻²
   double kappa = 0;  ///< κ, Å⁻¹
-  double energy(double d) const;
-  /// −(dE/dd)/d: the force on i is force_over_d(d) (X_i − X_j)
-  double force_over_d(double d) const;
+
+  /// One pair at distance d (Å): its energy A e^{−κd}/d and −(dE/dd)/d, so that the force on i
+  /// is force_over_d (X_i − X_j). One exponential for both.
+  struct Terms {
+    double energy;        ///< g Å² s⁻²
+    double force_over_d;  ///< g s⁻²
+  };
+  Terms at(double d) const {
+    const double inv = 1.0 / d;
+    const double e = A * std::exp(-kappa * d) * inv;  // A e^{−κd}/d
+    return {e, e * (inv + kappa) * inv};
+  }
+  /// the same from the squared distance d² (Å²), as the pair loops have it
+  Terms eval(double d2) const { return at(std::sqrt(d2)); }
+
+  /// E(d) = A e^{−κd}/d alone, as the reported energies and the cutoff shift have always been
+  /// computed: divided by d where at() multiplies by 1/d (equal to round-off; kept so that the
+  /// outputs stay bit for bit what they were).
+  double energy(double d) const { return A * std::exp(-kappa * d) / d; }
+  /// −(dE/dd)/d: the force on i is force_over_d(d) (X_i − X_j); at(d).force_over_d
+  double force_over_d(double d) const { return at(d).force_over_d; }
 };
 
 /// The pair law of MODEL (2.19–2.22) from natural parameters: charge per point q (e), dielectric
@@ -71,6 +93,12 @@ struct ElectroParams {
   DebyeHuckel law;
   double cutoff = 0;  ///< pairs farther apart than this (Å) are dropped; <= 0: no cutoff
 };
+
+/// ElectroParams from the config's natural parameters (io/config.cpp): the law of
+/// debye_huckel(charge_e, dielectric, salt_M) and the cutoff rc = cutoff_debye / κ Å, in Debye
+/// lengths (kDefaultCutoffDebye by default); no cutoff (0) when κ = 0 (no salt).
+ElectroParams electro_params(bool enabled, double charge_e, double dielectric, double salt_M,
+                             double cutoff_debye);
 
 /// Electrostatics over all pairs i < j of rod points (adjacent points included, as in the paper).
 /// Uses a cell list (cells of edge ≥ rc over the points' bounding box, O(n)) when it has at least

@@ -31,9 +31,10 @@ SegmentContact closest_points(const Vec3& P0, const Vec3& P1, const Vec3& Q0, co
       s = clamp01(nrm.cross(d2).dot(r) / denom);
     } else {
       // parallel: the minimisers fill the overlap of P with Q's projection on P; take its middle
-      const double sa = -c / a, sb = (b - c) / a;  // Q0, Q1 projected on P's parameter
-      const double lo = std::max(0.0, std::min(sa, sb)), hi = std::min(1.0, std::max(sa, sb));
-      s = lo <= hi ? 0.5 * (lo + hi) : (std::max(sa, sb) < 0.0 ? 0.0 : 1.0);
+      const double s_q0 = -c / a, s_q1 = (b - c) / a;  // Q0, Q1 projected on P's parameter
+      const double lo = std::max(0.0, std::min(s_q0, s_q1));
+      const double hi = std::min(1.0, std::max(s_q0, s_q1));
+      s = lo <= hi ? 0.5 * (lo + hi) : (std::max(s_q0, s_q1) < 0.0 ? 0.0 : 1.0);
     }
     // the point of Q nearest P(s); if it is off Q, clamp it and re-project onto P
     t = (b * s + f) / e;

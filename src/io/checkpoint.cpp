@@ -9,6 +9,7 @@
 #include "core/error.hpp"
 #include "io/atomic_file.hpp"
 #include "io/observables.hpp"
+#include "io/observables_json.hpp"
 
 namespace ibrod::io {
 
@@ -42,14 +43,6 @@ constexpr std::array<std::uint32_t, 256> make_crc_table() {
 }
 constexpr auto kCrcTable = make_crc_table();
 
-nlohmann::ordered_json observables_json(const sim::Observables& o) {
-  nlohmann::ordered_json j;
-  j["step"] = o.step;
-  j["time_us"] = o.time_us;
-  for (const auto& f : observable_fields()) j[f.name] = o.*f.member;
-  return j;
-}
-
 sim::Observables observables_from(const nlohmann::json& j) {
   sim::Observables o;
   o.step = j.at("step").get<std::int64_t>();
@@ -63,6 +56,7 @@ sim::Observables observables_from(const nlohmann::json& j) {
 std::string meta_json(const CheckpointMeta& m) {
   nlohmann::ordered_json j;
   j["step"] = m.step;
+  j["time_s"] = m.time_s;
   j["threads"] = m.threads;
   j["stop_reason"] = m.stop_reason;
   j["self_passage_warning"] = m.self_passage_warning;
@@ -79,6 +73,8 @@ CheckpointMeta meta_from(const std::string& text) {
   const nlohmann::json j = nlohmann::json::parse(text);
   CheckpointMeta m;
   m.step = j.at("step").get<std::int64_t>();
+  // checkpoints written before time was state have none: −1, the driver uses step × Δt
+  m.time_s = j.contains("time_s") ? j.at("time_s").get<double>() : -1.0;
   m.threads = j.at("threads").get<int>();
   m.stop_reason = j.at("stop_reason").get<std::string>();
   m.self_passage_warning = j.at("self_passage_warning").get<bool>();

@@ -1,5 +1,5 @@
 #pragma once
-// Checkpoints: the full state of a run — fluid velocity, rod X and D, step — plus what the run
+// Checkpoints: the full state of a run — fluid velocity, rod X and D, step and simulated time — plus what the run
 // driver needs to continue it exactly as if it had never stopped (the resolved config, the
 // thread count, the initial observables, the self-passage bookkeeping). ibrod has no random
 // state after the initial condition, so nothing else evolves. One binary file, little-endian:
@@ -31,6 +31,7 @@ inline constexpr std::uint32_t kCheckpointVersion = 1;
 /// Bookkeeping stored as JSON in the payload.
 struct CheckpointMeta {
   std::int64_t step = 0;
+  double time_s = 0;                 ///< simulated time, s (state: never step × Δt; −1 if absent)
   int threads = 1;                   ///< resolved OpenMP/FFTW threads of the run that wrote it
   std::string config_toml;           ///< to_toml() of the run's configuration
   std::string stop_reason = "none";  ///< "none" while running; end_time/equilibrium at the end

@@ -56,10 +56,9 @@ class H5mdWriter {
   struct Impl;
   std::unique_ptr<Impl> impl_;
   std::int64_t frames_ = 0;
-  std::string name_;
 };
 
-/// One element of /particles/rod (for tests and tools).
+/// One element of /particles/rod, every frame (analysis::read_trajectory_frames reads frames so).
 struct H5mdSeries {
   std::vector<std::int64_t> step;  ///< [T]
   std::vector<double> time_us;     ///< [T]

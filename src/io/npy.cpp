@@ -53,27 +53,4 @@ void write_velocity_npy(const std::filesystem::path& path, int n, const double* 
   f.commit(false);
 }
 
-void write_velocity_npy(const std::filesystem::path& path, const fluid::FluidSolver& fluid) {
-  write_velocity_npy(path, fluid.grid().n, fluid.velocity(0), fluid.velocity(1),
-                     fluid.velocity(2));
-}
-
-std::vector<double> read_velocity_npy(const std::filesystem::path& path, int& n) {
-  std::ifstream in(path, std::ios::binary);
-  char pre[10];
-  if (!in.read(pre, 10) || std::memcmp(pre, "\x93NUMPY", 6) != 0)
-    throw RunError("npy: " + path.string() + " is not a .npy file");
-  const std::size_t hlen = std::size_t(std::uint8_t(pre[8])) | std::size_t(std::uint8_t(pre[9])) << 8;
-  std::string dict(hlen, '\0');
-  in.read(dict.data(), std::streamsize(hlen));
-  const auto s = dict.find("'shape': (3, ");
-  if (!in || dict.find("'<f8'") == std::string::npos || s == std::string::npos)
-    throw RunError("npy: " + path.string() + " is not a (3, n, n, n) float64 array");
-  n = std::stoi(dict.substr(s + 13));
-  std::vector<double> v(3 * std::size_t(n) * n * n);
-  if (!in.read(reinterpret_cast<char*>(v.data()), std::streamsize(v.size() * sizeof(double))))
-    throw RunError("npy: " + path.string() + " is truncated");
-  return v;
-}
-
 }  // namespace ibrod::io

@@ -4,24 +4,16 @@
 // (component, i, j, k) with grid point (i, j, k) at x = (i, j, k) h, in Å/ns. Read with
 // `np.load(DIR + "/velocity.npy")`. Used by python/grid_convergence.py (docs/sweeps.md).
 //
-// The run driver calls write_velocity_npy(dir / "velocity.npy", sim.stepper().fluid()) once, after
+// The run driver calls write_velocity_npy(RunDir::velocity(), n, u_x, u_y, u_z) once, after
 // the last step, when Config::output_fluid_velocity is set.
 #include <filesystem>
 #include <vector>
 
-#include "fluid/navier_stokes.hpp"
 
 namespace ibrod::io {
 
-/// Writes the solver's velocity (converted from Å/s to Å/ns) atomically. Throws RunError.
-void write_velocity_npy(const std::filesystem::path& path, const fluid::FluidSolver& fluid);
-
-/// Same, from three arrays of n³ values each in Å/s (layout GridSpec::index).
+/// velocity.npy from three arrays of n³ values each in Å/s (layout GridSpec::index).
 void write_velocity_npy(const std::filesystem::path& path, int n, const double* ux,
                         const double* uy, const double* uz);
-
-/// Reads a file written by write_velocity_npy: n and the 3 n³ values in Å/ns (component-major).
-/// Throws RunError if it is not such a file. (Tests; the Python side uses numpy.)
-std::vector<double> read_velocity_npy(const std::filesystem::path& path, int& n);
 
 }  // namespace ibrod::io

@@ -1,4 +1,5 @@
 #include "io/vtk.hpp"
+#include "io/run_dir.hpp"
 
 #include <cstdio>
 #include <fstream>
@@ -141,8 +142,8 @@ void PvdSeries::resume(std::int64_t last_step) {
   }
   // files of later frames would be stale
   std::error_code ec;
-  if (fs::is_directory(dir_ / "vtk", ec))
-    for (const auto& e : fs::directory_iterator(dir_ / "vtk", ec)) {
+  if (fs::is_directory(dir_ / RunDir::kVtkDir, ec))
+    for (const auto& e : fs::directory_iterator(dir_ / RunDir::kVtkDir, ec)) {
       const std::string name = e.path().filename().string();
       if (std::regex_match(name, f, std::regex(prefix_ + "_([0-9]+)\\." + ext_)) &&
           std::stoll(f[1]) > last_step)
@@ -156,7 +157,7 @@ void PvdSeries::add(std::int64_t step, double time_us, const std::string& xml) {
   std::snprintf(name, sizeof name, "vtk/%s_%06lld.%s", prefix_.c_str(),
                 static_cast<long long>(step), ext_.c_str());
   std::error_code ec;
-  fs::create_directories(dir_ / "vtk", ec);
+  fs::create_directories(dir_ / RunDir::kVtkDir, ec);
   write_file_atomic(dir_ / name, xml);
   entries_.push_back({step, time_us, name});
   write_pvd();

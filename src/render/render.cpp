@@ -31,10 +31,11 @@ Hit ray_capsule(const Vec3& ro, const Vec3& rd, const Vec3& a, const Vec3& b, do
   if (qa > 0 && y > 0 && y < baba) return {t, y / baba};
   // sphere cap at a (y ≤ 0) or at b
   const Vec3 oc = (y <= 0) ? oa : Vec3(ro - b);
-  const double sb = rd.dot(oc), sc = oc.dot(oc) - r * r;
-  h = sb * sb - sc;
+  // the sphere's quadratic t² + 2 half_b t + c0 = 0 (|rd| = 1)
+  const double half_b = rd.dot(oc), c0 = oc.dot(oc) - r * r;
+  h = half_b * half_b - c0;
   if (h <= 0) return {-1, 0};
-  return {-sb - std::sqrt(h), y <= 0 ? 0.0 : 1.0};
+  return {-half_b - std::sqrt(h), y <= 0 ? 0.0 : 1.0};
 }
 
 std::uint8_t to_byte(double v) { return std::uint8_t(std::clamp(std::lround(v), 0L, 255L)); }

@@ -74,4 +74,12 @@ struct CircleParams {
 };
 RodState twisted_circle(const RodParams& p, const CircleParams& c);
 
+/// Radius of the circle of n points Δs apart (Å): r0 = n Δs / 2π (MODEL §5).
+double circle_radius(int n, double ds);
+
+/// sin β of the twisted circle (MODEL §5), the tilt of D³ out of the circle's plane that balances
+/// twist against shear: −a3 ΔLk / (b1 r0² + a3 − a1); a1 bend and a3 twist modulus (g Å³ s⁻²),
+/// b1 shear modulus (g Å s⁻²), r0 the radius (Å). The circle exists only for |sin β| ≤ 1.
+double circle_tilt_sin_beta(double a1, double a3, double b1, double r0, double excess_link);
+
 }  // namespace ibrod::rod

@@ -1,6 +1,7 @@
 #include "sim/simulation.hpp"
 
 #include <cmath>
+#include <stdexcept>
 #include <vector>
 
 #include "diagnostics/topology.hpp"
@@ -12,12 +13,40 @@ std::string to_string(StopReason r) {
     case StopReason::none: return "none";
     case StopReason::end_time: return "end_time";
     case StopReason::equilibrium: return "equilibrium";
+    case StopReason::interrupted: return "interrupted";
+    case StopReason::blow_up: return "blow_up";
+    case StopReason::error: return "error";
   }
   return "unknown";
 }
 
+StopReason stop_reason_from(const std::string& name) {
+  for (StopReason r : {StopReason::none, StopReason::end_time, StopReason::equilibrium,
+                       StopReason::interrupted, StopReason::blow_up, StopReason::error})
+    if (to_string(r) == name) return r;
+  return StopReason::error;
+}
+
+std::int64_t steps_to_reach(double t_end, double dt) {
+  return std::int64_t(std::ceil(t_end / dt - 0.5));
+}
+
+namespace {
+SimParams checked(SimParams p) {
+  if (!(p.dt > 0) || !(p.t_end > 0))
+    throw std::invalid_argument("Simulation: dt and t_end must be positive");
+  if (p.output.rows <= 0 || p.output.frames < 0 || p.output.checkpoints < 0)
+    throw std::invalid_argument("Simulation: output intervals must be positive (frames, "
+                                "checkpoints: or 0)");
+  p.stepper.fluid.dt = p.dt;  // the fluid's Δt is the simulation's
+  return p;
+}
+}  // namespace
+
 Simulation::Simulation(const SimParams& p)
-    : p_(p), rod_(rod::twisted_circle(p.stepper.rod, p.circle)), stepper_(p.stepper) {
+    : p_(checked(p)),
+      rod_(rod::twisted_circle(p_.stepper.rod, p_.circle)),
+      stepper_(p_.stepper) {
   // MODEL §6: the electrostatic energy is also reported relative to the circle at the same salt.
   // The unperturbed circle (perturbation only rotates triads, so X is the same).
   if (p_.stepper.electro.enabled) electro_circle_ = stepper_.electrostatics().energy(rod_.X);
@@ -26,6 +55,7 @@ Simulation::Simulation(const SimParams& p)
 void Simulation::step() {
   stepper_.step(rod_);
   ++step_;
+  time_ += p_.dt;
 }
 
 Observables Simulation::observe() {
@@ -60,16 +90,8 @@ Observables Simulation::observe() {
 
 StopReason Simulation::stop_reason(const Observables& o) const {
   if (step_ > 0 && o.E_kinetic_kT * p_.kT < p_.stop_kinetic) return StopReason::equilibrium;
-  // half a step of tolerance so that t_end = k Δt stops after exactly k steps
-  if (time() >= p_.t_end - 0.5 * p_.stepper.fluid.dt) return StopReason::end_time;
+  if (at_end()) return StopReason::end_time;
   return StopReason::none;
-}
-
-bool Simulation::finite() const {
-  for (int k = 0; k < rod_.size(); ++k)
-    if (!rod_.X[k].allFinite() || !rod_.D[k].allFinite()) return false;
-  // a NaN or Inf anywhere in the fluid makes the kinetic energy non-finite
-  return std::isfinite(stepper_.fluid_kinetic_energy());
 }
 
 }  // namespace ibrod::sim

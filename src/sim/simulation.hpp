@@ -1,6 +1,11 @@
 #pragma once
-// Simulation: parameters, rod state, the stepper and the diagnostics of one trajectory. No I/O
-// here (writers live in io/); the run driver calls step() and observe().
+// Simulation: parameters, rod state, the stepper and the diagnostics of one trajectory, and the
+// rules of its time loop: the time step Δt, the simulated time (state, advanced by each step and
+// restored from checkpoints, never recomputed as step × Δt), the output schedule (rows, frames,
+// checkpoints) and the stop rules. No I/O here (file formats live in io/, the loop that writes
+// them in driver/Run); the driver calls step(), asks output_due() / frame_due() /
+// checkpoint_due() and stop_reason(), and writes.
+#include <algorithm>
 #include <cstdint>
 #include <string>
 
@@ -9,13 +14,23 @@
 
 namespace ibrod::sim {
 
+/// When a run writes: a time-series row every `rows` steps and at the end; a trajectory frame
+/// every `frames` steps and at the end (0: none); a checkpoint every `checkpoints` steps (0: only
+/// at the start, at the end and on a signal).
+struct OutputSchedule {
+  std::int64_t rows = 1000;
+  std::int64_t frames = 1000;
+  std::int64_t checkpoints = 10000;
+};
+
 /// Everything a trajectory needs, in internal units (g, Å, s).
 struct SimParams {
-  integrate::StepperParams stepper;
+  integrate::StepperParams stepper;  ///< its fluid.dt is set from dt by Simulation
   rod::CircleParams circle;
+  double dt = 1e-10;            ///< time step Δt, s
   double t_end = 1e-6;          ///< s
   double stop_kinetic = 0;      ///< stop when E_K < this (g Å² s⁻²) at an output step; 0: never
-  std::int64_t output_every = 1000;  ///< steps between diagnostics
+  OutputSchedule output;
   double kT = 414.2;            ///< g Å² s⁻²
   int closest_min_separation = 20;   ///< pairs at least this many points apart (MODEL §6)
 };
@@ -32,11 +47,20 @@ struct Observables {
   double closest_approach_A = 0, bp_spacing_A = 0;
 };
 
-enum class StopReason { none, end_time, equilibrium };
+/// Why a run stopped (summary.json's stop_reason, the checkpoint's): none while it runs.
+enum class StopReason { none, end_time, equilibrium, interrupted, blow_up, error };
 std::string to_string(StopReason r);
+/// The reason named by to_string (ConfigError-free: an unknown name is StopReason::error).
+StopReason stop_reason_from(const std::string& name);
+
+/// The end-of-run rule: the number of steps of Δt that reach t_end (t_end = k Δt gives exactly
+/// k steps; half a step of tolerance).
+std::int64_t steps_to_reach(double t_end, double dt);
 
 class Simulation {
  public:
+  /// Builds the initial state (the twisted circle of p.circle). Throws std::invalid_argument for
+  /// a non-positive Δt or output interval.
   explicit Simulation(const SimParams& p);
 
   const SimParams& params() const { return p_; }
@@ -45,27 +69,48 @@ class Simulation {
   integrate::Stepper& stepper() { return stepper_; }
   const integrate::Stepper& stepper() const { return stepper_; }
   std::int64_t step_count() const { return step_; }
-  /// Sets the step counter (and so time()) when a checkpoint restores rod() and the fluid
-  /// velocity; nothing else of the state depends on it.
-  void restore_step_count(std::int64_t step) { step_ = step; }
-  double time() const { return step_ * p_.stepper.fluid.dt; }  ///< s
+  double time() const { return time_; }   ///< simulated time, s
+  double dt() const { return p_.dt; }     ///< time step, s
+  /// Sets the step counter and the simulated time when a checkpoint restores rod() and the fluid
+  /// velocity; nothing else of the state depends on them.
+  void restore_clock(std::int64_t step, double time) {
+    step_ = step;
+    time_ = time;
+  }
 
-  /// One time step.
+  /// One time step: the state and the time advance by Δt.
   void step();
+
+  /// Whether the simulated time has reached t_end, with half a step of tolerance (the
+  /// end-of-run rule: t_end = k Δt stops after exactly k steps; steps_to_reach).
+  bool at_end() const { return time_ >= p_.t_end - 0.5 * p_.dt; }
+  /// The step at which at_end() becomes true at the present Δt (progress lines, estimates).
+  std::int64_t end_step() const { return step_ + std::max<std::int64_t>(0, steps_to_reach(p_.t_end - time_, p_.dt)); }
+  /// Whether the current step is an output step: a time-series row is due (every
+  /// output.rows steps, and at the end).
+  bool output_due() const { return step_ % p_.output.rows == 0 || at_end(); }
+  /// Whether a trajectory frame is due at the current step (`stopping`: the run stops here).
+  bool frame_due(bool stopping) const {
+    return p_.output.frames > 0 && (step_ % p_.output.frames == 0 || stopping);
+  }
+  /// Whether a checkpoint is due at the current step (`stopping`: the run stops here).
+  bool checkpoint_due(bool stopping) const {
+    return (p_.output.checkpoints > 0 && step_ % p_.output.checkpoints == 0) || stopping;
+  }
   /// Diagnostics of the current state (O(n²) writhe and closest approach: output steps only).
-  /// With a distributed fluid every rank must call step(), observe() and finite() alike (the
-  /// kinetic energy is summed over the ranks).
+  /// With a distributed fluid every rank must call step() and observe() alike (the kinetic
+  /// energy is summed over the ranks).
   Observables observe();
-  /// Stop rule, checked at output steps: t ≥ t_end, or E_K below the threshold (after step 0).
+  /// The stop rules, checked at output steps (o: the row of the current step): E_K below the
+  /// threshold after step 0 (equilibrium), else the end of the time (end_time), else none.
   StopReason stop_reason(const Observables& o) const;
-  /// true if every position, triad and fluid velocity is finite
-  bool finite() const;
 
  private:
   SimParams p_;
   rod::RodState rod_;
   integrate::Stepper stepper_;
   std::int64_t step_ = 0;
+  double time_ = 0;               ///< s
   double electro_circle_ = 0;  ///< E_electro of the initial circle, g Å² s⁻²
 };
 

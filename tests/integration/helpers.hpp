@@ -2,12 +2,12 @@
 // Small configurations for integration tests: a 100-point ring (r0 ≈ 54 Å) in a 200 Å box on a
 // 16³ grid (h = 12.5 Å, close to the reference 11.3 Å), so that a run of a few thousand steps
 // takes seconds.
-#include "io/config.hpp"
+#include "config/config.hpp"
 
 namespace ibrod::test {
 
-inline io::Config small_config(int excess_link) {
-  io::Config c;
+inline config::Config small_config(int excess_link) {
+  config::Config c;
   c.grid_n = 16;
   c.grid_box_A = 200;
   c.rod_base_pairs = 100;

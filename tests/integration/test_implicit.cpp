@@ -12,7 +12,7 @@
 #include "diagnostics/topology.hpp"
 #include "helpers.hpp"
 #include "integrate/implicit.hpp"
-#include "io/config.hpp"
+#include "config/config.hpp"
 
 namespace ibrod {
 namespace {
@@ -25,9 +25,9 @@ struct Ring {
   std::unique_ptr<integrate::Stepper> st;
   std::unique_ptr<integrate::ImplicitStepper> imp;
   Ring(double beta, int threads = 1) {
-    io::Config c = test::small_config(3);
+    config::Config c = test::small_config(3);
     c.run_threads = threads;
-    p = io::to_params(c);
+    p = config::to_params(c);
     rod = rod::twisted_circle(p.stepper.rod, p.circle);
     st = std::make_unique<integrate::Stepper>(p.stepper);
     integrate::ImplicitParams ip;

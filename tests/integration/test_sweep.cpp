@@ -7,7 +7,7 @@
 
 #include <cstdlib>
 
-#include "io/sweep.hpp"
+#include "driver/sweep_runner.hpp"
 #include "run_helpers.hpp"
 
 using namespace ibrod;
@@ -26,8 +26,8 @@ std::string tiny_sweep() {
          "[sweep]\n\"rod.excess_link\" = [1, 2]\n\"solvent.salt_M\" = [0.05, 0.1]\n";
 }
 
-io::SweepOptions options(const fs::path& root, int jobs, std::FILE* log = nullptr) {
-  io::SweepOptions o;
+driver::SweepOptions options(const fs::path& root, int jobs, std::FILE* log = nullptr) {
+  driver::SweepOptions o;
   o.output_root = root;
   o.jobs = jobs;
   o.binary = IBROD_BINARY;
@@ -64,7 +64,7 @@ bool sweep_command_wired() {
 TEST(SweepRun, InterruptedPartWayAndStartedAgainFinishesEveryPointExactlyOnce) {
   const fs::path d = fresh_dir("sweep_resume");
   std::ofstream(d / "sweep.toml") << tiny_sweep();
-  const io::Sweep sw = io::load_sweep(d / "sweep.toml");
+  const driver::Sweep sw = driver::load_sweep(d / "sweep.toml");
   ASSERT_EQ(sw.points.size(), 4u);
   const fs::path root = d / "out";
   auto dir = [&](int i) { return root / sw.points[std::size_t(i)].name; };
@@ -73,7 +73,7 @@ TEST(SweepRun, InterruptedPartWayAndStartedAgainFinishesEveryPointExactlyOnce) {
   //    point 1 has written a checkpoint after its start
   const pid_t pid = ::fork();
   if (pid == 0) {
-    const io::SweepReport r = io::run_sweep(sw, options(root, 1));
+    const driver::SweepReport r = driver::run_sweep(sw, options(root, 1));
     ::_exit(r.signal ? 100 : r.failed);
   }
   const auto t0 = std::chrono::steady_clock::now();
@@ -92,14 +92,14 @@ TEST(SweepRun, InterruptedPartWayAndStartedAgainFinishesEveryPointExactlyOnce) {
   ::waitpid(pid, &st, 0);
   ASSERT_TRUE(caught) << "the sweep ended before it could be interrupted";
   EXPECT_EQ(WEXITSTATUS(st), 100);
-  EXPECT_EQ(io::point_state(dir(0)), io::PointState::finished);
-  const bool point1_interrupted = io::point_state(dir(1)) == io::PointState::interrupted;
+  EXPECT_EQ(driver::point_state(dir(0)), driver::PointState::finished);
+  const bool point1_interrupted = driver::point_state(dir(1)) == driver::PointState::interrupted;
   EXPECT_TRUE(point1_interrupted) << "point 1 finished before the signal reached it";
-  EXPECT_EQ(io::point_state(dir(2)), io::PointState::fresh);  // never started
-  EXPECT_EQ(io::point_state(dir(3)), io::PointState::fresh);
+  EXPECT_EQ(driver::point_state(dir(2)), driver::PointState::fresh);  // never started
+  EXPECT_EQ(driver::point_state(dir(3)), driver::PointState::fresh);
 
   // 2. started again (two at a time): point 0 skipped, point 1 resumed, points 2 and 3 run
-  const io::SweepReport r = io::run_sweep(sw, options(root, 2));
+  const driver::SweepReport r = driver::run_sweep(sw, options(root, 2));
   EXPECT_EQ(r.points, 4);
   EXPECT_EQ(r.skipped, 1);
   EXPECT_EQ(r.resumed, point1_interrupted ? 1 : 0);
@@ -123,7 +123,7 @@ TEST(SweepRun, InterruptedPartWayAndStartedAgainFinishesEveryPointExactlyOnce) {
   EXPECT_EQ(slurp(dir(1) / "timeseries.csv"), slurp(d / "direct" / "timeseries.csv"));
 
   // 3. a third time: nothing to do
-  const io::SweepReport again = io::run_sweep(sw, options(root, 2));
+  const driver::SweepReport again = driver::run_sweep(sw, options(root, 2));
   EXPECT_EQ(again.skipped, 4);
   EXPECT_EQ(again.fresh + again.resumed + again.failed, 0);
   EXPECT_THAT(slurp(root / "points.csv"), HasSubstr("1,dlk=1_salt_M=0.1,1,0.1\n"));
@@ -137,16 +137,16 @@ TEST(SweepRun, AFailedPointIsReportedAndTheOthersFinish) {
       << "[grid]\nn = 16\nbox_A = 200\n[rod]\nbase_pairs = 100\nexcess_link = 2\n[time]\n"
          "t_end_us = 0.2\n[output]\nevery_steps = 100\n[run]\nthreads = 1\nfftw_measure = false\n"
          "[sweep]\n\"time.dt_ns\" = [2.0, 0.1]\n";
-  const io::Sweep sw = io::load_sweep(d / "sweep.toml");
+  const driver::Sweep sw = driver::load_sweep(d / "sweep.toml");
   ASSERT_EQ(sw.points[0].name, "dt_ns=2");
-  const io::SweepReport r = io::run_sweep(sw, options(d / "out", 2));
+  const driver::SweepReport r = driver::run_sweep(sw, options(d / "out", 2));
   EXPECT_EQ(r.failed, 1);
   EXPECT_EQ(r.failed_names, std::vector<std::string>{"dt_ns=2"});
   EXPECT_EQ(r.completed, 1);
   EXPECT_EQ(stop_reason(d / "out" / "dt_ns=0.1"), "end_time");
   EXPECT_THAT(slurp(d / "out" / "logs" / "dt_ns=2.log"), HasSubstr("blow-up"));
   // again: the blown-up point is reported, not re-run; the finished one skipped
-  const io::SweepReport again = io::run_sweep(sw, options(d / "out", 2));
+  const driver::SweepReport again = driver::run_sweep(sw, options(d / "out", 2));
   EXPECT_EQ(again.failed, 1);
   EXPECT_EQ(again.skipped, 1);
   EXPECT_EQ(again.fresh + again.resumed, 0);
@@ -158,13 +158,13 @@ TEST(SweepRun, APointDirectoryOfAnotherConfigurationIsNotTouched) {
   std::ofstream(d / "sweep.toml")
       << "[grid]\nn = 16\nbox_A = 200\n[rod]\nbase_pairs = 100\n[time]\nt_end_us = 0.01\n"
          "[run]\nthreads = 1\nfftw_measure = false\n[sweep]\n\"rod.excess_link\" = [3]\n";
-  ASSERT_EQ(io::run_sweep(io::load_sweep(d / "sweep.toml"), options(d / "out", 1)).completed, 1);
+  ASSERT_EQ(driver::run_sweep(driver::load_sweep(d / "sweep.toml"), options(d / "out", 1)).completed, 1);
   // the same point name with another base value (t_end): refused, left as it is
   std::ofstream(d / "sweep.toml")
       << "[grid]\nn = 16\nbox_A = 200\n[rod]\nbase_pairs = 100\n[time]\nt_end_us = 0.02\n"
          "[run]\nthreads = 1\nfftw_measure = false\n[sweep]\n\"rod.excess_link\" = [3]\n";
   const std::string before = slurp(d / "out" / "dlk=3" / "summary.json");
-  const io::SweepReport r = io::run_sweep(io::load_sweep(d / "sweep.toml"), options(d / "out", 1));
+  const driver::SweepReport r = driver::run_sweep(driver::load_sweep(d / "sweep.toml"), options(d / "out", 1));
   EXPECT_EQ(r.failed, 1);
   EXPECT_EQ(slurp(d / "out" / "dlk=3" / "summary.json"), before);
   fs::remove_all(d);

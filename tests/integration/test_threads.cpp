@@ -30,7 +30,7 @@ Trajectory run(int threads, int steps) {
   c.grid_n = 32;                   // 4 spreading slabs (two run concurrently), h as in
   c.grid_box_A = 400;              // small_config: 12.5 Å
   c.run_threads = threads;
-  sim::Simulation s(io::to_params(c));
+  sim::Simulation s(config::to_params(c));
   Trajectory t;
   t.X0 = s.rod().X;
   for (int i = 0; i < steps; ++i) s.step();

@@ -5,15 +5,16 @@
 #include <cmath>
 #include <cstdio>
 
-#include "io/config.hpp"
+#include "config/config.hpp"
+#include "sim/rod_problem.hpp"
 #include "sim/simulation.hpp"
 
 using namespace ibrod;
 
 namespace {
 
-io::Config reference(int excess_link, double salt_M) {
-  io::Config c;  // defaults: MODEL §1
+config::Config reference(int excess_link, double salt_M) {
+  config::Config c;  // defaults: MODEL §1
   c.rod_excess_link = excess_link;
   c.solvent_salt_M = salt_M;
   c.rod_perturbation = {1.0};
@@ -28,8 +29,8 @@ struct Outcome {
 
 // Runs until `until(o)` holds at an output step or t_max (µs) passes; checks the link on the way.
 template <class Until>
-Outcome run(const io::Config& c, double t_max_us, int every, Until until) {
-  sim::Simulation s(io::to_params(c));
+Outcome run(const config::Config& c, double t_max_us, int every, Until until) {
+  sim::Simulation s(config::to_params(c));
   Outcome out;
   const double dlk = c.rod_excess_link;
   for (;;) {
@@ -38,7 +39,7 @@ Outcome run(const io::Config& c, double t_max_us, int every, Until until) {
     out.last = o;
     out.max_link_error = std::max(out.max_link_error, std::abs(o.link - dlk));
     out.min_closest = std::min(out.min_closest, o.closest_approach_A);
-    if (!s.finite() || until(o) || o.time_us >= t_max_us) break;
+    if (!sim::rod_problem(s.rod(), c.rod_rise_A).empty() || !std::isfinite(o.E_total_kT) || until(o) || o.time_us >= t_max_us) break;
   }
   std::printf("  ΔLk = %d, Cs = %g M: t = %.2f µs, Wr = %.4f, Lk = %.6f, closest %.2f Å, spacing "
               "%.4f Å, E_K = %.3e kT\n",

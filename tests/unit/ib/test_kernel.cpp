@@ -4,7 +4,7 @@
 #include <cmath>
 #include <random>
 
-#include "ib/coupling.hpp"
+#include "ib/kernel.hpp"
 
 namespace ibrod::ib {
 namespace {

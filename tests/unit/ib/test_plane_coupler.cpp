@@ -1,6 +1,6 @@
 // The plane-by-plane coupling of the time step (ib::PlaneCoupler): spreading into every x-plane
 // and sampling every x-plane must reproduce Coupler::spread and Coupler::interpolate (the
-// oracles, themselves tested against the direct definitions in test_coupling.cpp) to round-off,
+// oracles, themselves tested against the direct definitions in test_coupler.cpp) to round-off,
 // for the padded vector rows, the generic rows, stencils that cross the periodic seam, several
 // kernel widths and grid sizes, and whatever the order in which the planes are visited.
 #include <gtest/gtest.h>
@@ -10,7 +10,7 @@
 #include <random>
 #include <vector>
 
-#include "ib/coupling.hpp"
+#include "ib/plane_coupler.hpp"
 
 namespace ibrod::ib {
 namespace {

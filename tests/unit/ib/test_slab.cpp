@@ -10,7 +10,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "ib/coupling.hpp"
+#include "ib/coupler.hpp"
 
 namespace ibrod::ib {
 namespace {

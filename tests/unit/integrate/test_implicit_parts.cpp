@@ -8,7 +8,7 @@
 #include <random>
 
 #include "integrate/implicit.hpp"
-#include "io/config.hpp"
+#include "config/config.hpp"
 
 namespace ibrod::integrate {
 namespace {
@@ -18,14 +18,14 @@ struct Ring {
   rod::RodState rod;
   std::unique_ptr<Stepper> st;
   explicit Ring(int excess_link = 2) {
-    io::Config c;
+    config::Config c;
     c.grid_n = 16;
     c.grid_box_A = 200;
     c.rod_base_pairs = 60;
     c.rod_excess_link = excess_link;
     c.run_threads = 1;
     c.run_fftw_measure = false;
-    p = io::to_params(c);
+    p = config::to_params(c);
     rod = rod::twisted_circle(p.stepper.rod, p.circle);
     // a generic, strained state: random displacements (0.3 Å) and rotations (0.05 rad)
     std::mt19937_64 rng(11);

@@ -14,10 +14,7 @@ namespace {
 using namespace test;
 
 ElectroParams params(double salt_M, double cutoff_debye) {
-  ElectroParams p;
-  p.law = debye_huckel(kCharge, kDielectric, salt_M);
-  p.cutoff = cutoff_debye > 0 ? cutoff_debye / p.law.kappa : 0.0;
-  return p;
+  return electro_params(true, kCharge, kDielectric, salt_M, cutoff_debye);
 }
 
 std::vector<Vec3> forces(Electrostatics& e, std::span<const Vec3> X, double* E = nullptr) {
@@ -71,6 +68,20 @@ TEST(Electrostatics, PairLawForceIsMinusDerivative) {
   EXPECT_NEAR(E, law.energy(d), 1e-14 * E);
   EXPECT_LT((F[0] - law.force_over_d(d) * (X[0] - X[1])).norm(), 1e-14 * F[0].norm());
   EXPECT_GT(F[0].dot(X[0] - X[1]), 0);  // like charges repel
+}
+
+TEST(Electrostatics, PairEvaluatorAgreesWithItsParts) {
+  // eval(d²) is what the pair loops use; energy(d) and force_over_d(d) the same law
+  const DebyeHuckel law = debye_huckel(kCharge, kDielectric, 0.1);
+  for (double d : {3.4, 10.0, 40.0, 150.0}) {
+    const DebyeHuckel::Terms t = law.eval(d * d);
+    EXPECT_NEAR(t.energy, law.energy(d), 1e-14 * law.energy(d)) << d;
+    EXPECT_NEAR(t.force_over_d, law.force_over_d(d), 1e-14 * law.force_over_d(d)) << d;
+  }
+  // the config's parameters: rc in Debye lengths, none without salt
+  const ElectroParams p = electro_params(true, kCharge, kDielectric, 0.1, kDefaultCutoffDebye);
+  EXPECT_EQ(p.cutoff, kDefaultCutoffDebye / p.law.kappa);
+  EXPECT_EQ(electro_params(true, kCharge, kDielectric, 0.0, kDefaultCutoffDebye).cutoff, 0.0);
 }
 
 TEST(Electrostatics, TotalForceIsMinusGradient) {

@@ -15,8 +15,6 @@
 
 #include "core/error.hpp"
 #include "io/h5md.hpp"
-#include "io/progress.hpp"
-#include "io/run.hpp"
 #include "io/vtk.hpp"
 
 using namespace ibrod;
@@ -158,86 +156,4 @@ TEST(H5md, UnreadableFileIsARunError) {
     EXPECT_THAT(e.what(), HasSubstr("bad.h5"));
   }
   fs::remove_all(d);
-}
-
-namespace {
-struct Captured {
-  char* buf = nullptr;
-  std::size_t size = 0;
-  std::FILE* f = open_memstream(&buf, &size);
-  ~Captured() {
-    if (f) std::fclose(f);  // a test that read the text by fclose has set f to nullptr
-    std::free(buf);
-  }
-  std::string text() {
-    std::fflush(f);
-    return std::string(buf, size);
-  }
-};
-}  // namespace
-
-TEST(Progress, PlainLinesAreThrottledToOnePerIntervalPlusFirstAndLast) {
-  Captured out;
-  {
-    io::Progress p(out.f, /*tty=*/0, /*interval_s=*/10.0);
-    // one offer per 0.01 s over 60 s: 6000 offers
-    for (int i = 0; i < 6000; ++i) p.update("line " + std::to_string(i), 0.01 * i);
-    p.update("last", 60.0, /*last=*/true);
-  }
-  std::fclose(out.f);
-  out.f = nullptr;
-  std::string s(out.buf, out.size);
-  const auto lines = std::count(s.begin(), s.end(), '\n');
-  EXPECT_GE(lines, 7);   // first, at ~10, 20, 30, 40, 50 s, last
-  EXPECT_LE(lines, 8);
-  EXPECT_EQ(s.rfind("line 0\n", 0), 0u);
-  EXPECT_THAT(s, HasSubstr("last\n"));
-  EXPECT_EQ(s.find('\r'), std::string::npos);
-}
-
-TEST(Progress, FirstLineIsDueAfterOneIntervalEvenWithoutAnOutputStep) {
-  // a 256³ run reaches its first output step after minutes: the log must not stay silent
-  Captured out;
-  io::Progress p(out.f, /*tty=*/0, /*interval_s=*/10.0);
-  EXPECT_FALSE(p.due(0.0));
-  EXPECT_FALSE(p.due(9.9));
-  EXPECT_TRUE(p.due(10.0));
-  p.update("first", 12.0);
-  EXPECT_FALSE(p.due(21.9));
-  EXPECT_TRUE(p.due(22.0));
-}
-
-TEST(Progress, TerminalLineIsRewrittenInPlace) {
-  Captured out;
-  {
-    io::Progress p(out.f, /*tty=*/1, 10.0, /*tty_interval_s=*/0.0);
-    p.update("a long first line", 0.0);
-    p.update("short", 1.0);
-    p.message("warning: something");
-    p.update("done", 2.0, true);
-  }
-  std::fclose(out.f);
-  out.f = nullptr;
-  const std::string s(out.buf, out.size);
-  // the short line overwrites the long one completely; a message starts on its own line
-  EXPECT_EQ(s, "\ra long first line\rshort            \nwarning: something\n\rdone\n");
-}
-
-TEST(RodProblem, NamesThePointAndTheQuantity) {
-  // a ring of 10 points at spacing Δs with orthonormal triads
-  const double ds = 3.4, r = ds / (2 * std::sin(M_PI / 10));
-  rod::RodState s = twisted_line(10, ds, 1.0, 0.1);
-  for (int k = 0; k < 10; ++k)
-    s.X[k] = Vec3(r * std::cos(2 * M_PI * k / 10), r * std::sin(2 * M_PI * k / 10), 0);
-  EXPECT_EQ(io::rod_problem(s, ds), "");
-
-  rod::RodState nan = s;
-  nan.X[3][1] = std::nan("");
-  EXPECT_THAT(io::rod_problem(nan, ds), HasSubstr("position of point 3 is not finite"));
-  rod::RodState stretched = s;
-  stretched.X[4] *= 2.0;  // moves point 4 outwards by r = 5.5 Å = 1.6 Δs
-  EXPECT_THAT(io::rod_problem(stretched, ds), HasSubstr("spacing of points 3 and 4"));
-  rod::RodState skew = s;
-  skew.D[6](0, 1) += 0.01;
-  EXPECT_THAT(io::rod_problem(skew, ds), HasSubstr("triad of point 6 is off orthonormal"));
 }

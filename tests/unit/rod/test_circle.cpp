@@ -47,6 +47,15 @@ TEST(TwistedCircle, GeometryAndRightHandedTriads) {
   }
 }
 
+TEST(TwistedCircle, RadiusAndTiltFunctionsMatchTheFormulas) {
+  // the functions the config layer calls for its checks and report (MODEL §5)
+  const RodParams p;
+  EXPECT_EQ(circle_radius(p.n, p.ds), r0_ref);
+  for (int dlk : {-6, 0, 3, 6})
+    EXPECT_EQ(circle_tilt_sin_beta(p.a.x(), p.a.z(), p.b.x(), r0_ref, dlk), sin_beta(p, dlk))
+        << dlk;
+}
+
 TEST(TwistedCircle, RejectsImpossibleTilt) {
   RodParams p;
   p.n = 10;  // r0 = 5.4 Å: b r0² ≈ a3, so |sin β| > 1 for ΔLk = 6

@@ -1,0 +1,192 @@
+// `ibrod analyze` on a run directory (analyze.hpp).
+#include "analysis/analyze.hpp"
+
+#include <nlohmann/json.hpp>
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include "io/run_dir.hpp"
+#include "core/error.hpp"
+#include "core/text_file.hpp"
+#include "config/toml_error.hpp"
+#include "io/atomic_file.hpp"
+#include "io/h5md.hpp"
+
+namespace ibrod::analysis {
+
+using namespace ibrod::io;
+
+namespace fs = std::filesystem;
+using json = nlohmann::ordered_json;
+
+namespace {
+
+FitWindow fit_window(const diag::LineFit& f, std::span<const double> t, double tolerance) {
+  return {t[f.first], t[f.first + f.count - 1], f.count, f.r2, f.max_abs_residual,
+          f.max_abs_residual <= tolerance};
+}
+
+json fit_json(const std::optional<FitWindow>& f) {
+  if (!f) return nullptr;
+  return json{{"t_start_us", f->t_start_us},
+              {"t_end_us", f->t_end_us},
+              {"points", f->points},
+              {"r2", f->r2},
+              {"max_abs_residual", f->max_abs_residual},
+              {"within_tolerance", f->within_tolerance}};
+}
+
+json optional_json(const std::optional<double>& v) { return v ? json(*v) : json(nullptr); }
+
+
+}  // namespace
+
+// ---- config
+
+RunInfo read_run_info(const fs::path& dir) {
+  RunInfo info;
+  const fs::path p = RunDir(dir).config();
+  if (!fs::exists(p)) return info;
+  const toml::table tbl = config::parse_toml(read_text_file(p, "analyze"), p.string(), "analyze");
+  info.diameter_A = tbl["steric"]["diameter_A"].value<double>().value_or(info.diameter_A);
+  info.excess_link = tbl["rod"]["excess_link"].value<int>().value_or(info.excess_link);
+  info.salt_M = tbl["solvent"]["salt_M"].value<double>().value_or(info.salt_M);
+  if (!(info.diameter_A > 0))
+    throw ConfigError("'" + p.string() + "': steric.diameter_A must be positive");
+  return info;
+}
+
+// ---- analyze
+
+Analysis analyze_timeseries(const CsvTable& table, const AnalyzeOptions& opt) {
+  // rows in strictly increasing time: where time goes back (a run continued from an earlier
+  // checkpoint appends rows it had already written), the later rows win
+  const auto time = table.column("time_us");
+  std::vector<std::size_t> keep;
+  for (std::size_t i = table.rows(); i-- > 0;)
+    if (std::isfinite(time[i]) && (keep.empty() || time[i] < time[keep.back()])) keep.push_back(i);
+  std::reverse(keep.begin(), keep.end());
+  CsvTable ts;
+  ts.path = table.path;
+  ts.names = table.names;
+  for (const auto& col : table.columns) {
+    ts.columns.emplace_back();
+    for (std::size_t i : keep) ts.columns.back().push_back(col[i]);
+  }
+
+  const std::size_t n = ts.rows();
+  if (n < 2)
+    throw ConfigError("'" + ts.path.string() + "' has " + std::to_string(n) +
+                      " rows in increasing time; the analysis needs at least 2");
+  const auto t = ts.column("time_us");
+  const auto wr = ts.column("writhe");
+  const auto ek = ts.column("E_kinetic_kT");
+  const auto et = ts.column("E_total_kT");
+  const auto ca = ts.column("closest_approach_A");
+  const std::size_t last = n - 1;
+  Analysis a;
+  a.rows = n;
+
+  a.writhe_final = wr[last];
+  a.writhe_convergence_time_us = diag::writhe_convergence_time(t, wr, opt.writhe_delta);
+
+  if (const auto fit = diag::relaxation_time(t, ek, opt.fit)) {
+    a.relaxation_time_us = fit->tau;
+    a.relaxation_fit = fit_window(fit->line, t, opt.fit.tolerance);
+  }
+  for (const auto& s : diag::transients(t, ek, et, opt.transients))
+    a.transients.push_back({s.time, s.kinetic, s.total, wr[s.index], s.plateau_start, s.plateau_end});
+
+  a.closest_approach_A = ca[last];
+  const auto imin = std::size_t(std::min_element(ca.begin(), ca.end()) - ca.begin());
+  a.closest_approach_min_A = ca[imin];
+  a.closest_approach_min_time_us = t[imin];
+
+  for (const char* c : {"E_bend_kT", "E_twist_kT", "E_stretch_kT", "E_electro_kT", "dE_electro_kT",
+                        "E_steric_kT", "E_kinetic_kT", "E_total_kT"})
+    if (ts.has(c)) a.final_energies_kT.emplace_back(c, ts.column(c)[last]);
+
+  double max_wr = 0;
+  for (double w : wr) max_wr = std::max(max_wr, std::abs(w));
+  a.stays_circular = max_wr < opt.circular_writhe;
+  if (a.stays_circular) {
+    if (const auto fit = diag::power_law_exponent(t, ek, opt.fit)) {
+      a.kinetic_power_law_exponent = fit->exponent;
+      a.kinetic_power_law_fit = fit_window(fit->line, t, opt.fit.tolerance);
+    }
+  }
+  return a;
+}
+
+namespace {
+
+json to_json(const Analysis& a, const AnalyzeOptions& opt) {
+  json j;
+  j["writhe_final"] = a.writhe_final;
+  j["writhe_convergence_time_us"] = a.writhe_convergence_time_us;
+  j["relaxation_time_us"] = optional_json(a.relaxation_time_us);
+  j["relaxation_fit"] = fit_json(a.relaxation_fit);
+  json tr = json::array();
+  for (const auto& s : a.transients)
+    tr.push_back(json{{"time_us", s.time_us},
+                      {"E_kinetic_kT", s.E_kinetic_kT},
+                      {"E_total_kT", s.E_total_kT},
+                      {"writhe", s.writhe},
+                      {"plateau_start_us", s.plateau_start_us},
+                      {"plateau_end_us", s.plateau_end_us}});
+  j["transients"] = tr;
+  j["closest_approach_A"] = a.closest_approach_A;  // non-finite (no admissible pair): null
+  j["closest_approach_min_A"] = a.closest_approach_min_A;
+  j["closest_approach_min_time_us"] = a.closest_approach_min_time_us;
+  json e = json::object();
+  for (const auto& [name, v] : a.final_energies_kT) e[name] = v;
+  j["final_energies_kT"] = e;
+  j["stays_circular"] = a.stays_circular;
+  j["kinetic_power_law_exponent"] = optional_json(a.kinetic_power_law_exponent);
+  j["kinetic_power_law_fit"] = fit_json(a.kinetic_power_law_fit);
+  j["analysis"] = json{{"source", "timeseries.csv"},
+                       {"rows", a.rows},
+                       {"writhe_delta", opt.writhe_delta},
+                       {"circular_writhe", opt.circular_writhe},
+                       {"fit_tolerance_ln", opt.fit.tolerance},
+                       {"fit_min_points", opt.fit.min_points},
+                       {"transient_min_rise", opt.transients.min_rise},
+                       {"transient_plateau_fraction", opt.transients.plateau_fraction}};
+  return j;
+}
+
+}  // namespace
+
+std::string analysis_json(const Analysis& a, const AnalyzeOptions& opt) {
+  return to_json(a, opt).dump(2);
+}
+
+Analysis analyze_run(const fs::path& dir, const AnalyzeOptions& opt) {
+  if (!fs::is_directory(dir)) throw ConfigError("'" + dir.string() + "' is not a directory");
+  const Analysis a = analyze_timeseries(read_csv_table(RunDir(dir).timeseries()), opt);
+  const fs::path sp = RunDir(dir).summary();
+  json summary = json::object();
+  if (fs::exists(sp)) {
+    try {
+      summary = json::parse(read_text_file(sp, "analyze"));
+    } catch (const json::parse_error& e) {
+      throw ConfigError("'" + sp.string() + "' is not valid JSON: " + e.what());
+    }
+    if (!summary.is_object()) throw ConfigError("'" + sp.string() + "' is not a JSON object");
+  }
+  const json added = to_json(a, opt);
+  for (const auto& [k, v] : added.items()) summary[k] = v;
+  write_file_atomic(sp, summary.dump(4) + "\n");
+  return a;
+}
+
+// ---- frames
+
+}  // namespace ibrod::analysis

@@ -1,0 +1,92 @@
+#pragma once
+// Post-processing of a run directory (the files `ibrod run` writes): `ibrod analyze` adds the
+// time-series analysis of MODEL §6 to summary.json (the rod's frames and `ibrod render`:
+// analysis/frames.hpp). The numbers and the fit method are explained in docs/analysis.md.
+// Missing or malformed input files throw ConfigError (exit status 2), failed writes RunError (3).
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/types.hpp"
+#include "diagnostics/relaxation.hpp"
+#include "io/csv.hpp"
+
+namespace ibrod::analysis {
+
+using io::CsvTable;
+using io::read_csv_table;
+
+/// The keys of config.toml that post-processing needs (read leniently: other keys are ignored,
+/// so directories written by other versions still work).
+struct RunInfo {
+  double diameter_A = 20.0;  ///< steric.diameter_A: the tube diameter in pictures
+  int excess_link = 0;       ///< rod.excess_link
+  double salt_M = 0;         ///< solvent.salt_M
+};
+/// Reads DIR/config.toml; defaults (diameter 20 Å) for a missing file or key. A file that is not
+/// TOML throws ConfigError.
+RunInfo read_run_info(const std::filesystem::path& dir);
+
+struct AnalyzeOptions {
+  double writhe_delta = 0.01;           ///< δ of the writhe convergence time
+  double circular_writhe = 0.05;        ///< a run "stays circular" while |Wr| < this throughout
+  diag::WindowOptions fit;              ///< final-window fits (ln E_K; tolerance in ln units)
+  diag::TransientOptions transients;
+};
+
+/// The window and quality of a final-window fit (diag::fit_final_linear_window).
+struct FitWindow {
+  double t_start_us = 0, t_end_us = 0;
+  std::size_t points = 0;
+  double r2 = 0;
+  double max_abs_residual = 0;  ///< in ln E_K
+  bool within_tolerance = false;
+};
+
+/// A transient state (diag::transients) with the writhe at its E_K minimum.
+struct TransientState {
+  double time_us = 0, E_kinetic_kT = 0, E_total_kT = 0, writhe = 0;
+  double plateau_start_us = 0, plateau_end_us = 0;
+};
+
+/// The analysis of one time series; each field is the summary.json key of the same name.
+struct Analysis {
+  std::size_t rows = 0;
+  double writhe_final = 0;
+  double writhe_convergence_time_us = 0;
+  std::optional<double> relaxation_time_us;  ///< τ of E_K ∝ exp(−2t/τ); none if E_K does not decay
+  std::optional<FitWindow> relaxation_fit;
+  std::vector<TransientState> transients;
+  double closest_approach_A = 0;             ///< at the last row
+  double closest_approach_min_A = 0;         ///< over the run
+  double closest_approach_min_time_us = 0;
+  std::vector<std::pair<std::string, double>> final_energies_kT;  ///< column name, last row
+  bool stays_circular = false;               ///< |Wr| < AnalyzeOptions::circular_writhe throughout
+  std::optional<double> kinetic_power_law_exponent;  ///< only for runs that stay circular
+  std::optional<FitWindow> kinetic_power_law_fit;
+};
+
+/// The analysis of timeseries.csv's columns (time_us, writhe, E_kinetic_kT, E_total_kT,
+/// closest_approach_A are needed; ConfigError otherwise, or with fewer than 2 rows). Rows whose
+/// time is not below that of every later row (a continued run that rewrote a stretch) are
+/// dropped: the later rows win.
+Analysis analyze_timeseries(const CsvTable& table, const AnalyzeOptions& opt = {});
+
+/// The analysis as the JSON object of keys `ibrod analyze` adds to summary.json:
+/// writhe_final, writhe_convergence_time_us, relaxation_time_us, relaxation_fit, transients,
+/// closest_approach_A, closest_approach_min_A, closest_approach_min_time_us, final_energies_kT,
+/// stays_circular, kinetic_power_law_exponent, kinetic_power_law_fit, and analysis (the options
+/// used and the number of rows). Absent values are null.
+std::string analysis_json(const Analysis& a, const AnalyzeOptions& opt = {});
+
+/// Reads DIR/timeseries.csv and adds analysis_json's keys to DIR/summary.json (replacing earlier
+/// ones, keeping every other key; created if missing), written atomically (temporary file +
+/// rename). Returns the analysis.
+Analysis analyze_run(const std::filesystem::path& dir, const AnalyzeOptions& opt = {});
+
+}  // namespace ibrod::analysis

@@ -1,0 +1,94 @@
+#pragma once
+// The user's configuration: a TOML file plus `--set section.key=value` overrides, in user units
+// (Å, ns, µs, kT, mol/L, poise, erg·cm, dyn; each key's unit is in its name or in `describe()`).
+// Every key has a default (the reference parameters of MODEL §1); unknown keys and invalid
+// values throw ConfigError naming the key, the value and what is allowed.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "rod/perturbation.hpp"
+#include "sim/simulation.hpp"
+
+namespace ibrod::config {
+
+struct Config {
+  // [grid]
+  int grid_n = 64;                 ///< grid.n: points per box edge (even, ≥ 8)
+  double grid_box_A = 725.0;       ///< grid.box_A: periodic box edge, Å
+  int grid_kernel_width = 1;       ///< grid.kernel_width: c/h, positive integer
+  // [time]
+  double time_dt_ns = 0.1;         ///< time.dt_ns: Δt, ns
+  double time_t_end_us = 0.5;      ///< time.t_end_us: simulated time, µs
+  double time_stop_kinetic_kT = 1e-12;  ///< time.stop_kinetic_kT: stop when E_K below, kT (0: never)
+  // [rod]
+  int rod_base_pairs = 600;        ///< rod.base_pairs: rod points n
+  int rod_excess_link = 6;         ///< rod.excess_link: ΔLk (integer)
+  std::vector<double> rod_perturbation{1.0};  ///< rod.perturbation: ε_m, m = 1, 2, …, rad
+  rod::RandomPerturbation rod_perturbation_random;  ///< rod.perturbation_random: drawn ε_m, added
+  double rod_rise_A = 3.4;         ///< rod.rise_A: Δs, Å
+  double rod_bend_modulus_erg_cm = 1.3e-19;   ///< a1 = a2, erg·cm
+  double rod_twist_modulus_erg_cm = 1.82e-19; ///< a3, erg·cm
+  double rod_shear_modulus_dyn = 5e-5;        ///< b1 = b2, dyn
+  double rod_stretch_modulus_dyn = 5e-5;      ///< b3, dyn
+  double rod_intrinsic_twist_per_A = 0.0;     ///< Ω³₀, rad/Å
+  // [solvent]
+  double solvent_salt_M = 0.1;          ///< Cs, mol/L
+  double solvent_viscosity_poise = 0.01;
+  double solvent_density_g_cm3 = 1.0;
+  double solvent_temperature_K = 300.0;
+  bool solvent_advection = true;        ///< include the nonlinear advection term
+  // [electrostatics]
+  bool electrostatics_enabled = true;
+  double electrostatics_charge_e = 0.48;     ///< charge per base pair, e
+  double electrostatics_dielectric = 77.7;   ///< εw
+  double electrostatics_cutoff_debye = 0;    ///< set from interactions::kDefaultCutoffDebye
+  // [steric]
+  bool steric_enabled = true;
+  double steric_diameter_A = 20.0;      ///< D, Å
+  double steric_stiffness_kT_A2 = 0;    ///< g, kT/Å²; set from interactions::kDefaultStericStiffness
+  // [output]
+  std::int64_t output_every_steps = 1000;      ///< output.every_steps: steps between rows
+  std::int64_t output_frame_every_steps = -1;  ///< steps between trajectory frames; 0: none;
+                                               ///< −1: same as output.every_steps (frame_every())
+  std::int64_t output_checkpoint_every_steps = 10000;  ///< steps between checkpoints; 0: only at
+                                                       ///< start, end and on SIGINT/SIGTERM
+  bool output_fluid_vti = false;               ///< fluid velocity .vti with every frame
+  bool output_fluid_velocity = false;          ///< DIR/velocity.npy at the end (io/npy.hpp)
+  // [run]
+  int run_threads = 0;                  ///< 0: OpenMP default (OMP_NUM_THREADS or all cores)
+  bool run_fftw_measure = true;         ///< FFTW_MEASURE plans (false: FFTW_ESTIMATE)
+
+  Config();
+};
+
+/// Steps between trajectory frames (output.frame_every_steps resolved: −1 → output.every_steps);
+/// 0: no trajectory.
+std::int64_t frame_every(const Config& c);
+
+/// Parse a TOML document (file contents) on top of the defaults.
+void apply_toml(Config& c, const std::string& toml_text, const std::string& source_name);
+/// Load a TOML file on top of the defaults (an empty path: defaults only).
+Config load_config(const std::string& path);
+/// Apply one `section.key=value` override; value is TOML (numbers, true/false, [arrays], "strings").
+void apply_override(Config& c, const std::string& assignment);
+/// Cross-key checks (ring fits in the box, kernel fits in the grid, …); throws ConfigError.
+void validate(const Config& c);
+/// The resolved config as a TOML document (every key, with its value).
+std::string to_toml(const Config& c);
+/// One line per key: name, value, unit and meaning (for `ibrod check` and docs).
+std::string describe(const Config& c);
+
+/// "key: old → new; …" for every key whose value differs between the configuration `old_toml`
+/// (a run's config.toml or a checkpoint's, read from `source`) and `now`; "" if none. A document
+/// this ibrod cannot read is reported as a difference.
+std::string config_differences(const std::string& old_toml, const Config& now,
+                               const std::string& source);
+
+/// Convert to internal units (g, Å, s) for the simulation.
+sim::SimParams to_params(const Config& c);
+
+/// Derived quantities for `ibrod check`: h, c, Δs, r0, 1/κ, Bjerrum length, steps, memory.
+std::string derived_report(const Config& c);
+
+}  // namespace ibrod::config

@@ -1,0 +1,128 @@
+#include <cmath>
+#include <sstream>
+
+#include "config/config.hpp"
+#include "config/detail.hpp"
+#include "core/units.hpp"
+#include "interactions/interactions.hpp"
+#include "rod/rod.hpp"
+
+// From the user's configuration (user units) to the simulation's parameters (internal units):
+// the cross-key checks, the conversion and the derived quantities of `ibrod check`.
+namespace ibrod::config {
+
+using detail::bad;
+using detail::fmt;
+
+void validate(const Config& c) {
+  if (c.grid_n % 2 != 0)
+    bad("grid.n", std::to_string(c.grid_n), "an even integer >= 8 (real-to-complex FFT grid)");
+  if (4 * c.grid_kernel_width + 2 > c.grid_n)
+    bad("grid.kernel_width", std::to_string(c.grid_kernel_width),
+        "an integer m with 4m + 2 <= grid.n = " + std::to_string(c.grid_n) +
+            " (the kernel must fit in the grid)");
+  const double r0 = rod::circle_radius(c.rod_base_pairs, c.rod_rise_A);
+  const double extent = 2 * r0 + c.steric_diameter_A;
+  if (extent >= c.grid_box_A)
+    bad("grid.box_A", fmt(c.grid_box_A),
+        "a box larger than the ring: rod.base_pairs = " + std::to_string(c.rod_base_pairs) +
+            " at rod.rise_A = " + fmt(c.rod_rise_A) + " gives a ring of diameter " +
+            fmt(2 * r0) + " Å (plus the hard core " + fmt(c.steric_diameter_A) + " Å)");
+  if (c.time_dt_ns * 1e-3 > c.time_t_end_us)
+    bad("time.t_end_us", fmt(c.time_t_end_us),
+        "at least one time step (time.dt_ns = " + fmt(c.time_dt_ns) + " ns)");
+  // MODEL §5: sin β must be a sine
+  const double a = c.rod_bend_modulus_erg_cm * units::erg_cm;
+  const double a3 = c.rod_twist_modulus_erg_cm * units::erg_cm;
+  const double b = c.rod_shear_modulus_dyn * units::dyn;
+  const double sin_beta = rod::circle_tilt_sin_beta(a, a3, b, r0, c.rod_excess_link);
+  if (!(std::abs(sin_beta) < 1))
+    bad("rod.excess_link", std::to_string(c.rod_excess_link),
+        "a link small enough that the twisted circle exists (|sin β| = " + fmt(std::abs(sin_beta)) +
+            " >= 1)");
+}
+
+
+sim::SimParams to_params(const Config& c) {
+  using namespace units;
+  sim::SimParams p;
+  auto& s = p.stepper;
+  s.grid.n = c.grid_n;
+  s.grid.L = c.grid_box_A * angstrom;
+  s.kernel_width = c.grid_kernel_width;
+  s.fluid.density = c.solvent_density_g_cm3 * g_per_cm3;
+  s.fluid.viscosity = c.solvent_viscosity_poise * poise;
+  p.dt = c.time_dt_ns * ns;
+  s.fluid.dt = p.dt;
+  s.fluid.advection = c.solvent_advection;
+  s.rod.n = c.rod_base_pairs;
+  s.rod.ds = c.rod_rise_A * angstrom;
+  const double a = c.rod_bend_modulus_erg_cm * erg_cm;
+  s.rod.a = Vec3(a, a, c.rod_twist_modulus_erg_cm * erg_cm);
+  const double b = c.rod_shear_modulus_dyn * dyn;
+  s.rod.b = Vec3(b, b, c.rod_stretch_modulus_dyn * dyn);
+  s.rod.omega0 = Vec3(0, 0, c.rod_intrinsic_twist_per_A);
+  p.kT = kT(c.solvent_temperature_K);
+  // MODEL (2.19–2.22): A = q²/(4π ε0 εw), κ = 0.329 √Cs
+  s.electro = interactions::electro_params(c.electrostatics_enabled, c.electrostatics_charge_e,
+                                           c.electrostatics_dielectric, c.solvent_salt_M,
+                                           c.electrostatics_cutoff_debye);
+  s.steric.enabled = c.steric_enabled;
+  s.steric.diameter = c.steric_diameter_A;
+  s.steric.stiffness = c.steric_stiffness_kT_A2 * p.kT;
+  s.steric.ds = s.rod.ds;
+  s.threads = c.run_threads;
+  s.plan_measure = c.run_fftw_measure;
+  p.circle.excess_link = c.rod_excess_link;
+  p.circle.perturbation = combined_perturbation(c.rod_perturbation, c.rod_perturbation_random);
+  // the ring sits in the middle of the box
+  p.circle.center = Vec3::Constant(0.5 * s.grid.L);
+  p.t_end = c.time_t_end_us * us;
+  p.stop_kinetic = c.time_stop_kinetic_kT * p.kT;
+  p.output.rows = c.output_every_steps;
+  p.output.frames = frame_every(c);
+  p.output.checkpoints = c.output_checkpoint_every_steps;
+  return p;
+}
+
+
+std::string derived_report(const Config& c) {
+  const auto p = to_params(c);
+  const auto& s = p.stepper;
+  const double h = s.grid.h();
+  const double r0 = rod::circle_radius(s.rod.n, s.rod.ds);
+  const double sin_beta =
+      rod::circle_tilt_sin_beta(s.rod.a[0], s.rod.a[2], s.rod.b[0], r0, c.rod_excess_link);
+  const auto steps = sim::steps_to_reach(p.t_end, p.dt);
+  const double N3 = double(s.grid.size());
+  // velocity + force (3 real arrays each) + spectrum (3 complex half arrays)
+  const double fluid_bytes = 8.0 * (6 * N3 + 2 * 3 * s.grid.n * s.grid.n * (s.grid.n / 2 + 1));
+  std::ostringstream os;
+  os.precision(5);
+  os << "grid spacing h            = " << h << " Å\n"
+     << "kernel width c            = " << c.grid_kernel_width * h << " Å (" << c.grid_kernel_width
+     << " h)\n"
+     << "rod spacing Δs            = " << s.rod.ds << " Å\n"
+     << "ring radius r0            = " << r0 << " Å\n"
+     << "tilt angle β              = " << std::asin(sin_beta) << " rad\n"
+     << "kT                        = " << p.kT << " g Å² s⁻²\n"
+     << "Debye length 1/κ          = "
+     << (s.electro.law.kappa > 0 ? 1.0 / s.electro.law.kappa : INFINITY) << " Å\n"
+     << "Bjerrum length            = "
+     << units::bjerrum_length(c.electrostatics_dielectric, c.solvent_temperature_K) << " Å\n"
+     << "electrostatic cutoff      = " << s.electro.cutoff << " Å\n"
+     << "steric stiffness g        = " << s.steric.stiffness << " g s⁻²\n"
+     << "time steps                = " << steps << "\n"
+     << "diagnostics rows          = " << steps / p.output.rows + 1 << "\n"
+     << "memory estimate           = " << (fluid_bytes + 400.0 * s.rod.n) / (1 << 20) << " MiB\n";
+  // docs/outputs.md: checkpoint = 3 N³ velocities + 12 n rod numbers; a frame = 4 × n × 3 numbers
+  const std::int64_t frames = p.output.frames > 0 ? steps / p.output.frames + 1 : 0;
+  os << "checkpoint size           = " << (24.0 * N3 + 96.0 * s.rod.n) / (1 << 20) << " MiB\n"
+     << "trajectory frames         = " << frames << " (H5MD ≈ "
+     << frames * 96.0 * s.rod.n / (1 << 20) << " MiB, .vtp ≈ "
+     << frames * 270.0 * s.rod.n / (1 << 20) << " MiB)\n";
+  return os.str();
+}
+
+
+}  // namespace ibrod::config

@@ -1,0 +1,404 @@
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <sstream>
+
+#include <toml++/toml.h>
+
+#include "config/config.hpp"
+#include "config/detail.hpp"
+#include "config/toml_error.hpp"
+#include "core/error.hpp"
+#include "core/text_file.hpp"
+#include "core/units.hpp"
+#include "interactions/interactions.hpp"
+
+// The schema of the user's configuration: every key, how it is read from TOML or `--set`, how it
+// is written back, and its unit and meaning.
+namespace ibrod::config {
+
+using detail::bad;
+using detail::fmt;
+using rod::draw_perturbation;
+using rod::RandomPerturbation;
+
+Config::Config()
+    : electrostatics_cutoff_debye(interactions::kDefaultCutoffDebye),
+      steric_stiffness_kT_A2(interactions::kDefaultStericStiffness / units::kT(300.0)) {}
+
+
+namespace {
+
+std::string show(const toml::node& n) {
+  std::ostringstream os;
+  n.visit([&](auto&& v) { os << v; });
+  return os.str();
+}
+
+
+// One config key: how to read it from TOML into Config, and how to write it back.
+struct Key {
+  std::string name;  // "section.key"
+  std::string help;  // unit and meaning
+  std::function<void(Config&, const toml::node&)> set;
+  std::function<void(const Config&, toml::table&)> put;  // into its section table
+  std::function<std::string(const Config&)> value;
+};
+
+std::string section_of(const std::string& k) { return k.substr(0, k.find('.')); }
+std::string leaf_of(const std::string& k) { return k.substr(k.find('.') + 1); }
+
+double as_number(const std::string& key, const toml::node& n, const std::string& allowed) {
+  if (auto v = n.value_exact<double>()) return *v;
+  if (auto v = n.value_exact<int64_t>()) return double(*v);
+  bad(key, show(n), allowed);
+}
+
+int64_t as_integer(const std::string& key, const toml::node& n, const std::string& allowed) {
+  if (auto v = n.value_exact<int64_t>()) return *v;
+  if (auto v = n.value_exact<double>())  // 2.0 is accepted as 2, 2.5 is not
+    if (std::isfinite(*v) && std::floor(*v) == *v && std::abs(*v) < 9e15) return int64_t(*v);
+  bad(key, show(n), allowed);
+}
+
+// A real number in (lo, hi] or [lo, hi] (lo_open picks), finite.
+Key real(std::string name, double Config::*m, double lo, bool lo_open, double hi,
+         std::string help) {
+  std::string allowed = "a number " + std::string(lo_open ? "> " : ">= ") + fmt(lo) +
+                        (hi < std::numeric_limits<double>::max() ? " and <= " + fmt(hi) : "");
+  Key k;
+  k.name = name;
+  k.help = help;
+  k.set = [=](Config& c, const toml::node& n) {
+    const double v = as_number(name, n, allowed + " (" + help + ")");
+    if (!std::isfinite(v) || (lo_open ? v <= lo : v < lo) || v > hi)
+      bad(name, show(n), allowed + " (" + help + ")");
+    c.*m = v;
+  };
+  k.put = [=](const Config& c, toml::table& t) { t.insert_or_assign(leaf_of(name), c.*m); };
+  k.value = [=](const Config& c) { return fmt(c.*m); };
+  return k;
+}
+
+template <class Int>
+Key integer(std::string name, Int Config::*m, int64_t lo, int64_t hi, std::string help) {
+  std::string allowed = "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  Key k;
+  k.name = name;
+  k.help = help;
+  k.set = [=](Config& c, const toml::node& n) {
+    const int64_t v = as_integer(name, n, allowed + " (" + help + ")");
+    if (v < lo || v > hi) bad(name, show(n), allowed + " (" + help + ")");
+    c.*m = Int(v);
+  };
+  k.put = [=](const Config& c, toml::table& t) { t.insert_or_assign(leaf_of(name), int64_t(c.*m)); };
+  k.value = [=](const Config& c) { return std::to_string(c.*m); };
+  return k;
+}
+
+Key boolean(std::string name, bool Config::*m, std::string help) {
+  Key k;
+  k.name = name;
+  k.help = help;
+  k.set = [=](Config& c, const toml::node& n) {
+    auto v = n.value_exact<bool>();
+    if (!v) bad(name, show(n), "true or false (" + help + ")");
+    c.*m = *v;
+  };
+  k.put = [=](const Config& c, toml::table& t) { t.insert_or_assign(leaf_of(name), c.*m); };
+  k.value = [=](const Config& c) { return std::string(c.*m ? "true" : "false"); };
+  return k;
+}
+
+Key real_array(std::string name, std::vector<double> Config::*m, double max_abs, std::string help) {
+  const std::string allowed = "an array of numbers with |value| <= " + fmt(max_abs) + " (" + help + ")";
+  Key k;
+  k.name = name;
+  k.help = help;
+  k.set = [=](Config& c, const toml::node& n) {
+    const toml::array* a = n.as_array();
+    if (!a) bad(name, show(n), allowed);
+    std::vector<double> out;
+    for (const toml::node& e : *a) {
+      const double v = as_number(name, e, allowed);
+      if (!std::isfinite(v) || std::abs(v) > max_abs) bad(name, show(n), allowed);
+      out.push_back(v);
+    }
+    c.*m = out;
+  };
+  k.put = [=](const Config& c, toml::table& t) {
+    toml::array a;
+    for (double v : c.*m) a.push_back(v);
+    t.insert_or_assign(leaf_of(name), a);
+  };
+  k.value = [=](const Config& c) {
+    std::string s = "[";
+    for (std::size_t i = 0; i < (c.*m).size(); ++i) s += (i ? ", " : "") + fmt((c.*m)[i]);
+    return s + "]";
+  };
+  return k;
+}
+
+const double inf = std::numeric_limits<double>::max();
+
+// output.frame_every_steps: −1 (the default) follows output.every_steps; written back resolved, so
+// that config.toml holds the number of steps actually used.
+Key frame_key() {
+  Key k = integer("output.frame_every_steps", &Config::output_frame_every_steps, -1,
+                  std::numeric_limits<int64_t>::max(),
+                  "steps between trajectory frames (H5MD and ParaView; 0: none, -1: same as "
+                  "output.every_steps)");
+  k.put = [](const Config& c, toml::table& t) {
+    t.insert_or_assign("frame_every_steps", int64_t(frame_every(c)));
+  };
+  k.value = [](const Config& c) { return std::to_string(frame_every(c)); };
+  return k;
+}
+
+// rod.perturbation_random = { modes = M, amplitude = A, seed = S }: an inline table (a Key whose
+// value is a table). A partial table changes only the sub-keys it names, so that `--set
+// rod.perturbation_random.seed=7` (see set_key) works on top of a file's table. Written back as the
+// table; the drawn ε_m follow from it exactly (io/perturbation.hpp) and `ibrod check` shows them.
+Key random_perturbation_key() {
+  const std::string name = "rod.perturbation_random";
+  const std::string help =
+      "random twist perturbation { modes = M, amplitude = A rad, seed = S }: ε_m, m = 1..M, "
+      "uniform in [-A, A) from std::mt19937_64(S), added to rod.perturbation";
+  Key k;
+  k.name = name;
+  k.help = help;
+  k.set = [=](Config& c, const toml::node& n) {
+    const toml::table* t = n.as_table();
+    if (!t) bad(name, show(n), "an inline table { modes = M, amplitude = A, seed = S }");
+    RandomPerturbation r = c.rod_perturbation_random;
+    for (auto&& [sub, v] : *t) {
+      const std::string s(sub.str());
+      const std::string full = name + "." + s;
+      if (s == "modes") {
+        const int64_t m = as_integer(full, v, "an integer in [0, 10000] (number of modes M)");
+        if (m < 0 || m > 10000) bad(full, show(v), "an integer in [0, 10000] (number of modes M)");
+        r.modes = int(m);
+      } else if (s == "amplitude") {
+        const double a = as_number(full, v, "a number in [0, 100] (amplitude A, rad)");
+        if (!std::isfinite(a) || a < 0 || a > 100)
+          bad(full, show(v), "a number in [0, 100] (amplitude A, rad)");
+        r.amplitude = a;
+      } else if (s == "seed") {
+        const int64_t sd = as_integer(full, v, "an integer >= 0 (seed of std::mt19937_64)");
+        if (sd < 0) bad(full, show(v), "an integer >= 0 (seed of std::mt19937_64)");
+        r.seed = std::uint64_t(sd);
+      } else {
+        throw ConfigError("config: unknown key '" + full + "' (keys in " + name +
+                          ": modes, amplitude, seed)");
+      }
+    }
+    c.rod_perturbation_random = r;
+  };
+  k.put = [](const Config& c, toml::table& t) {
+    const RandomPerturbation& r = c.rod_perturbation_random;
+    toml::table v{{"modes", int64_t(r.modes)}, {"amplitude", r.amplitude},
+                  {"seed", int64_t(r.seed)}};
+    v.is_inline(true);
+    t.insert_or_assign("perturbation_random", v);
+  };
+  k.value = [](const Config& c) {
+    const RandomPerturbation& r = c.rod_perturbation_random;
+    std::string s = "{ modes = " + std::to_string(r.modes) + ", amplitude = " + fmt(r.amplitude) +
+                    ", seed = " + std::to_string(r.seed) + " }";
+    const std::vector<double> eps = draw_perturbation(r);
+    if (!eps.empty()) {
+      s += " -> eps = [";
+      for (std::size_t i = 0; i < eps.size(); ++i) s += (i ? ", " : "") + fmt(eps[i]);
+      s += "]";
+    }
+    return s;
+  };
+  return k;
+}
+
+// The public interface: every key ibrod understands, in output order.
+const std::vector<Key>& schema() {
+  static const std::vector<Key> keys = {
+      integer("grid.n", &Config::grid_n, 8, 1024, "grid points per box edge, even"),
+      real("grid.box_A", &Config::grid_box_A, 0, true, inf, "periodic box edge L, Å"),
+      integer("grid.kernel_width", &Config::grid_kernel_width, 1, 16,
+              "kernel width c/h, a positive integer"),
+      real("time.dt_ns", &Config::time_dt_ns, 0, true, inf, "time step Δt, ns"),
+      real("time.t_end_us", &Config::time_t_end_us, 0, true, inf, "simulated time, µs"),
+      real("time.stop_kinetic_kT", &Config::time_stop_kinetic_kT, 0, false, inf,
+           "stop when the fluid kinetic energy falls below this, kT (0: never)"),
+      integer("rod.base_pairs", &Config::rod_base_pairs, 8, 1000000,
+              "rod points = base pairs n"),
+      integer("rod.excess_link", &Config::rod_excess_link, -1000, 1000,
+              "excess link ΔLk of the initial circle, an integer"),
+      real_array("rod.perturbation", &Config::rod_perturbation, 100.0,
+                 "twist perturbation amplitudes ε_m for m = 1, 2, …, rad"),
+      random_perturbation_key(),
+      real("rod.rise_A", &Config::rod_rise_A, 0, true, inf, "rise per base pair Δs, Å"),
+      real("rod.bend_modulus_erg_cm", &Config::rod_bend_modulus_erg_cm, 0, true, inf,
+           "bending moduli a1 = a2, erg·cm"),
+      real("rod.twist_modulus_erg_cm", &Config::rod_twist_modulus_erg_cm, 0, true, inf,
+           "twist modulus a3, erg·cm"),
+      real("rod.shear_modulus_dyn", &Config::rod_shear_modulus_dyn, 0, true, inf,
+           "shear constants b1 = b2, dyn"),
+      real("rod.stretch_modulus_dyn", &Config::rod_stretch_modulus_dyn, 0, true, inf,
+           "stretch constant b3, dyn"),
+      real("rod.intrinsic_twist_per_A", &Config::rod_intrinsic_twist_per_A, -inf, false, inf,
+           "intrinsic twist Ω³₀, rad/Å (0: untwisted reference)"),
+      real("solvent.salt_M", &Config::solvent_salt_M, 0, false, 10.0,
+           "monovalent salt concentration Cs, mol/L"),
+      real("solvent.viscosity_poise", &Config::solvent_viscosity_poise, 0, true, inf,
+           "viscosity μ, poise (g/(cm·s))"),
+      real("solvent.density_g_cm3", &Config::solvent_density_g_cm3, 0, true, inf,
+           "density ρ, g/cm³"),
+      real("solvent.temperature_K", &Config::solvent_temperature_K, 0, true, inf,
+           "temperature for kT, K"),
+      boolean("solvent.advection", &Config::solvent_advection,
+              "include the nonlinear advection term ρ u·∇u"),
+      boolean("electrostatics.enabled", &Config::electrostatics_enabled,
+              "Debye–Hückel repulsion between rod points"),
+      real("electrostatics.charge_e", &Config::electrostatics_charge_e, 0, false, inf,
+           "net charge per base pair, e"),
+      real("electrostatics.dielectric", &Config::electrostatics_dielectric, 0, true, inf,
+           "dielectric constant of water εw"),
+      real("electrostatics.cutoff_debye", &Config::electrostatics_cutoff_debye, 0, true, inf,
+           "pair cutoff in Debye lengths 1/κ"),
+      boolean("steric.enabled", &Config::steric_enabled, "hard-core repulsion between segments"),
+      real("steric.diameter_A", &Config::steric_diameter_A, 0, true, inf,
+           "hard-core diameter D, Å"),
+      real("steric.stiffness", &Config::steric_stiffness_kT_A2, 0, false, inf,
+           "hard-core spring constant g, kT/Å²"),
+      integer("output.every_steps", &Config::output_every_steps, 1,
+              std::numeric_limits<int64_t>::max(), "steps between diagnostics rows"),
+      frame_key(),
+      integer("output.checkpoint_every_steps", &Config::output_checkpoint_every_steps, 0,
+              std::numeric_limits<int64_t>::max(),
+              "steps between checkpoints (0: only at the start, the end and on SIGINT/SIGTERM)"),
+      boolean("output.fluid_vti", &Config::output_fluid_vti,
+              "also write the fluid velocity (Å/ns) as a ParaView .vti image with every frame"),
+      boolean("output.fluid_velocity", &Config::output_fluid_velocity,
+              "write the final fluid velocity (Å/ns) as DIR/velocity.npy, shape (3, n, n, n)"),
+      integer("run.threads", &Config::run_threads, 0, 1024,
+              "threads (0: OMP_NUM_THREADS or all cores)"),
+      boolean("run.fftw_measure", &Config::run_fftw_measure,
+              "time FFTW plans at start (faster steps) instead of estimating them"),
+  };
+  return keys;
+}
+
+const Key* find_key(const std::string& name) {
+  for (const Key& k : schema())
+    if (k.name == name) return &k;
+  return nullptr;
+}
+
+std::string known_keys_in(const std::string& section) {
+  std::string s;
+  for (const Key& k : schema())
+    if (section_of(k.name) == section) s += (s.empty() ? "" : ", ") + leaf_of(k.name);
+  return s;
+}
+
+std::string known_sections() {
+  std::string s;
+  std::string last;
+  for (const Key& k : schema()) {
+    const std::string sec = section_of(k.name);
+    if (sec != last) s += (s.empty() ? "" : ", ") + sec;
+    last = sec;
+  }
+  return s;
+}
+
+void set_key(Config& c, const std::string& name, const toml::node& n) {
+  const Key* k = find_key(name);
+  // a sub-key of a table-valued key (rod.perturbation_random.seed): set as a one-entry table
+  if (const auto dot = name.rfind('.'); !k && dot != std::string::npos && dot > name.find('.')) {
+    if (const Key* parent = find_key(name.substr(0, dot))) {
+      toml::table t;
+      t.insert(name.substr(dot + 1), n);
+      parent->set(c, t);
+      return;
+    }
+  }
+  if (!k) {
+    const std::string known = known_keys_in(section_of(name));
+    if (name.find('.') == std::string::npos || known.empty())
+      throw ConfigError("config: unknown key '" + name + "' (sections are: " + known_sections() +
+                        ")");
+    throw ConfigError("config: unknown key '" + name + "' (keys in [" + section_of(name) +
+                      "]: " + known + ")");
+  }
+  k->set(c, n);
+}
+
+}  // namespace
+
+std::int64_t frame_every(const Config& c) {
+  return c.output_frame_every_steps < 0 ? c.output_every_steps : c.output_frame_every_steps;
+}
+
+
+void apply_toml(Config& c, const std::string& text, const std::string& source) {
+  const toml::table tbl = parse_toml(text, source, "config");
+  for (auto&& [sec, node] : tbl) {
+    const std::string s(sec.str());
+    const toml::table* t = node.as_table();
+    if (!t)
+      throw ConfigError("config: top-level key '" + s + "' must be a section [" + s +
+                        "] (sections are: " + known_sections() + ")");
+    for (auto&& [key, value] : *t) set_key(c, s + "." + std::string(key.str()), value);
+  }
+}
+
+
+Config load_config(const std::string& path) {
+  Config c;
+  if (path.empty()) return c;
+  apply_toml(c, read_text_file(path, "config"), path);
+  return c;
+}
+
+
+void apply_override(Config& c, const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw ConfigError("config: --set '" + assignment + "' must have the form section.key=value");
+  std::string key = assignment.substr(0, eq), value = assignment.substr(eq + 1);
+  while (!key.empty() && key.back() == ' ') key.pop_back();
+  toml::table t;
+  try {
+    t = toml::parse("v = " + value, "--set " + key);
+  } catch (const toml::parse_error& e) {
+    throw ConfigError("config: --set " + key + "=" + value +
+                      ": the value is not a TOML number, boolean, string or array (" +
+                      std::string(e.description()) + ")");
+  }
+  set_key(c, key, *t.get("v"));
+}
+
+
+std::string to_toml(const Config& c) {
+  toml::table root;
+  for (const Key& k : schema()) {
+    const std::string sec = section_of(k.name);
+    if (!root.contains(sec)) root.insert(sec, toml::table{});
+    k.put(c, *root[sec].as_table());
+  }
+  std::ostringstream os;
+  os << "# ibrod resolved configuration (every key, defaults included)\n" << root << "\n";
+  return os.str();
+}
+
+
+std::string describe(const Config& c) {
+  std::ostringstream os;
+  for (const Key& k : schema()) {
+    std::string lhs = k.name + " = " + k.value(c);
+    if (lhs.size() < 44) lhs.resize(44, ' ');
+    os << lhs << " # " << k.help << "\n";
+  }
+  return os.str();
+}
+
+}  // namespace ibrod::config

@@ -1,0 +1,490 @@
+#include "driver/run.hpp"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <vector>
+
+#include "core/error.hpp"
+#include "driver/mpi_env.hpp"
+#include "driver/progress.hpp"
+#include "driver/run_files.hpp"
+#include "driver/signals.hpp"
+#include "fluid/distributed_fluid.hpp"
+#include "fluid/fftw_wisdom.hpp"
+#include "io/atomic_file.hpp"
+#include "io/checkpoint.hpp"
+#include "io/csv.hpp"
+#include "io/npy.hpp"
+#include "io/run_dir.hpp"
+#include "sim/rod_problem.hpp"
+
+namespace ibrod::driver {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+using sim::StopReason;
+
+namespace {
+
+/// "H:MM:SS" of a duration in seconds ("?" if unknown).
+std::string format_duration(double seconds) {
+  if (!std::isfinite(seconds) || seconds < 0) return "?";
+  const long s = std::lround(seconds);
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%ld:%02ld:%02ld", s / 3600, (s / 60) % 60, s % 60);
+  return buf;
+}
+
+std::string format_g(double v, int digits = 6) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+  return buf;
+}
+
+double seconds_since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+/// A run that has already stopped, resumed without a change: nothing to do.
+struct AlreadyFinished {};
+
+}  // namespace
+
+// Everything one run holds between its steps. Under MPI (ranks > 1) rank 0 alone writes (files
+// is null elsewhere); every write goes through on_root so that a failure there stops every rank.
+struct Run::State {
+  config::Config user;   // as given (config.toml is written from it)
+  config::Config c;      // as run (threads resolved on resume)
+  RunOptions opt;
+  io::RunDir dir;
+  std::string config_text;
+  Clock::time_point t0 = Clock::now();
+  bool distributed = false;
+  Progress progress;
+
+  std::optional<io::Checkpoint> checkpoint;  // the one to continue from, until it is applied
+  bool config_changed = false;
+  std::optional<sim::Simulation> sim;
+  std::unique_ptr<RunFiles> files;           // rank 0 only
+  std::vector<double> gathered;              // distributed: the whole velocity on rank 0
+  io::CheckpointMeta meta;
+  RunResult result;
+  double wall_before = 0;                    // wall time of the earlier segments, s
+  Clock::time_point loop_start;
+  std::int64_t start_step = 0;
+  std::uintmax_t reserve_bytes = 0;
+  sim::Observables last_row;                 // the row of the latest output step
+
+  State(const config::Config& cfg, const RunOptions& o)
+      : user(cfg),
+        c(cfg),
+        opt(o),
+        dir(o.output_dir),
+        config_text(config::to_toml(cfg)),
+        distributed(o.ranks > 1),
+        progress(o.rank == 0 ? o.log : nullptr, o.tty) {}
+
+  void say(const std::string& s) { progress.message(s); }
+  void on_root(const std::function<void()>& f) { mpi::on_root(opt.rank, opt.ranks, f); }
+
+  void check_launch() const;
+  void open_checkpoint();
+  void prepare_directory();
+  void build_simulation();
+  void restore_state();
+  void open_files();
+  void announce();
+
+  double ms_per_step() const {
+    return 1e3 * seconds_since(loop_start) /
+           double(std::max<std::int64_t>(sim->step_count() - start_step, 1));
+  }
+  std::string progress_line(const sim::Observables& o) const;
+  void write_frame();
+  void ensure_space() {
+    on_root([&] { files->ensure_space(reserve_bytes); });
+  }
+  void write_checkpoint(StopReason reason);
+  void finish(const sim::Observables& o, const std::string& stop_reason, const std::string& error);
+  [[noreturn]] void blow_up(const std::string& what);
+  sim::Observables observe_checked();
+  void check_link(const sim::Observables& o);
+  RunResult loop(const SignalGuard& signals);
+};
+
+void Run::State::check_launch() const {
+  if (distributed && c.grid_n % opt.ranks != 0)
+    throw ConfigError("run: grid.n = " + std::to_string(c.grid_n) + " cannot be split over " +
+                      std::to_string(opt.ranks) + " MPI ranks: each rank holds grid.n/K x-planes "
+                      "of the fluid, so the rank count K of `mpirun -np K` must divide grid.n");
+  if (distributed && !fluid::distributed_available())
+    throw ConfigError("run: this ibrod was built without FFTW MPI; run it without mpirun");
+  if (!opt.fftw_wisdom.empty() && !fluid::import_wisdom(opt.fftw_wisdom))
+    throw ConfigError("run: cannot read FFTW wisdom from '" + opt.fftw_wisdom + "'");
+}
+
+// --resume: the checkpoint must fit the configuration (the grid and the rod exactly; any other
+// key only with --force). A run that already stopped and is resumed unchanged has nothing to do.
+void Run::State::open_checkpoint() {
+  const fs::path cp = dir.checkpoint();
+  std::error_code ec;
+  if (!fs::exists(cp, ec))
+    throw ConfigError("resume: " + cp.string() +
+                      " does not exist (the run stopped before its first checkpoint, or '" +
+                      dir.root().string() + "' is not an ibrod output directory); start it again "
+                      "with --overwrite");
+  checkpoint = io::read_checkpoint(cp);
+  const io::Checkpoint& ck = *checkpoint;
+  if (ck.grid_n != c.grid_n || ck.rod.size() != c.rod_base_pairs)
+    throw ConfigError("resume: " + cp.string() + " holds a " + std::to_string(ck.grid_n) +
+                      "³ grid and " + std::to_string(ck.rod.size()) +
+                      " rod points; the configuration asks for grid.n = " +
+                      std::to_string(c.grid_n) + " and rod.base_pairs = " +
+                      std::to_string(c.rod_base_pairs) + ": incompatible, even with --force");
+  const std::string diff = config::config_differences(ck.meta.config_toml, user, cp.string());
+  config_changed = !diff.empty();
+  if (config_changed && !opt.force)
+    throw ConfigError("resume: the configuration differs from the one " + cp.string() +
+                      " was written with (" + diff +
+                      "); pass --force to continue with the new values (the continued run is "
+                      "then not the uninterrupted run of either configuration)");
+  if (config_changed)
+    say("ibrod: warning: resuming with a changed configuration (--force): " + diff);
+  if (ck.meta.stop_reason != "none" && !config_changed) {
+    say("ibrod: the run in " + dir.root().string() + " already stopped (" +
+        ck.meta.stop_reason + ") at step " + std::to_string(ck.meta.step) + "; nothing to do");
+    result.already_finished = true;
+    result.steps = ck.meta.step;
+    result.initial = ck.meta.initial;
+    result.resumed_from = result.checkpoint_step = ck.meta.step;
+    result.reason = sim::stop_reason_from(ck.meta.stop_reason);
+    throw AlreadyFinished{};
+  }
+  // the same threads as the run that wrote the checkpoint: the same round-off
+  if (c.run_threads == 0) c.run_threads = ck.meta.threads;
+}
+
+void Run::State::prepare_directory() {
+  if (checkpoint) {
+    if (config_changed) on_root([&] { io::write_file_atomic(dir.config(), config_text); });
+    return;
+  }
+  on_root([&] {
+    prepare_output_dir(dir, opt.overwrite);
+    io::write_file_atomic(dir.config(), config_text);
+  });
+}
+
+void Run::State::build_simulation() {
+  // FFTW plans: import the run's own wisdom on resume, so that FFTW_MEASURE picks the plans of
+  // the first segment (different plans round differently)
+  if (checkpoint && c.run_fftw_measure) {
+    std::error_code ec;
+    if (!fs::exists(dir.wisdom(), ec) || !fluid::import_wisdom(dir.wisdom().string()))
+      say("ibrod: warning: cannot read " + dir.wisdom().string() +
+          "; FFTW may choose other plans than before, so the continued run may differ from an "
+          "uninterrupted one in the last bits");
+  }
+  sim::SimParams params = config::to_params(c);
+  params.stepper.distributed = distributed;
+  try {
+    sim.emplace(params);
+  } catch (const std::invalid_argument& e) {
+    if (!distributed) throw;
+    // the distributed fluid checks what every rank sees alike: a bad input on every rank
+    throw ConfigError(std::string("run: ") + e.what());
+  }
+  // distributed: rank 0 holds every rank's plans (fftw_mpi_gather_wisdom)
+  on_root([&] {
+    const std::string wisdom = fluid::wisdom_text();
+    if (wisdom.empty()) throw RunError("output: cannot export the FFTW plans");
+    io::write_file_atomic(dir.wisdom(), wisdom);
+  });
+}
+
+void Run::State::restore_state() {
+  if (checkpoint) {
+    const io::Checkpoint& ck = *checkpoint;
+    meta = ck.meta;
+    ++meta.resumes;
+    sim->rod() = ck.rod;
+    const std::size_t n3 = sim->params().stepper.grid.size();
+    const double* v = ck.velocity.data();
+    sim->stepper().set_whole_velocity({v, v + n3, v + 2 * n3});
+    // checkpoints from before time was state: step × Δt of the run that wrote them
+    const double time = meta.time_s >= 0 ? meta.time_s : double(meta.step) * sim->dt();
+    sim->restore_clock(meta.step, time);
+    result.initial = meta.initial;
+    result.resumed_from = result.checkpoint_step = meta.step;
+    checkpoint.reset();  // the state lives in sim now; free the copy
+  }
+  meta.config_toml = config_text;
+  meta.threads = sim->stepper().fluid_threads();
+  meta.stop_reason = to_string(StopReason::none);
+  wall_before = meta.wall_s;
+}
+
+void Run::State::open_files() {
+  on_root([&] {
+    files = std::make_unique<RunFiles>(dir, c, *sim, result.resumed_from, config_text, progress);
+  });
+  // free space kept in hand: a checkpoint (written beside the previous one), a few frames
+  // (H5MD + .vtp, ~300 B per point, + the .vti) and 16 MiB of slack
+  const std::uintmax_t n = std::uintmax_t(c.grid_n);
+  reserve_bytes = 24 * n * n * n +
+                  4 * (300u * std::uintmax_t(c.rod_base_pairs) +
+                       (c.output_fluid_vti ? 48u * n * n * n : 0u)) +
+                  (std::uintmax_t(16) << 20);
+}
+
+void Run::State::announce() {
+  if (!opt.log) return;
+  char buf[512];
+  const auto& p = sim->params();
+  if (result.resumed_from >= 0)
+    std::snprintf(buf, sizeof buf,
+                  "ibrod: resuming %s at step %lld/%lld (%d threads, checkpoint every %lld steps)",
+                  dir.root().c_str(), static_cast<long long>(result.resumed_from),
+                  static_cast<long long>(sim->end_step()), meta.threads,
+                  static_cast<long long>(p.output.checkpoints));
+  else
+    std::snprintf(buf, sizeof buf,
+                  "ibrod: %lld steps of %.4g ns on %d³, %d rod points, ΔLk = %d, %d threads -> %s",
+                  static_cast<long long>(sim->end_step()), sim->dt() / 1e-9, p.stepper.grid.n,
+                  p.stepper.rod.n, p.circle.excess_link, meta.threads, dir.root().c_str());
+  say(buf);
+  if (distributed)
+    say("ibrod: the fluid grid is split over " + std::to_string(opt.ranks) + " MPI ranks (" +
+        std::to_string(p.stepper.grid.n / opt.ranks) + " x-planes each, " +
+        std::to_string(meta.threads) + " threads per rank); rank 0 writes the output");
+}
+
+std::string Run::State::progress_line(const sim::Observables& o) const {
+  const double ms = ms_per_step();
+  const std::int64_t end = sim->end_step();
+  char buf[320];
+  std::snprintf(buf, sizeof buf,
+                "step %lld/%lld  t = %.4f us  Wr = %+.4f  Lk = %+.4f  E_K = %.3e kT  "
+                "%.3f ms/step  ETA %s",
+                static_cast<long long>(sim->step_count()), static_cast<long long>(end),
+                sim->time() / 1e-6, o.writhe, o.link, o.E_kinetic_kT, ms,
+                format_duration(1e-3 * ms * double(end - sim->step_count())).c_str());
+  return buf;
+}
+
+void Run::State::write_frame() {
+  if (sim->params().output.frames <= 0) return;
+  std::array<const double*, 3> u{};
+  if (c.output_fluid_vti) u = sim->stepper().whole_velocity(gathered);
+  on_root([&] { files->frame(*sim, u); });
+}
+
+void Run::State::write_checkpoint(StopReason reason) {
+  meta.step = sim->step_count();
+  meta.time_s = sim->time();
+  meta.stop_reason = to_string(reason);
+  meta.wall_s = wall_before + seconds_since(t0);
+  const auto u = sim->stepper().whole_velocity(gathered);
+  on_root([&] {
+    io::write_checkpoint(dir.checkpoint(), meta, sim->rod(), sim->params().stepper.grid.n, u);
+  });
+  result.checkpoint_step = meta.step;
+}
+
+void Run::State::finish(const sim::Observables& o, const std::string& stop_reason,
+                        const std::string& error) {
+  RunResult& r = result;
+  r.steps = sim->step_count();
+  r.time_us = sim->time() / 1e-6;
+  r.final = o;
+  r.wall_s = seconds_since(t0);
+  r.ms_per_step = ms_per_step();
+  r.link_drift = o.link - r.initial.link;
+  r.max_link_drift = meta.max_link_drift;
+  r.self_passage_warning = meta.self_passage_warning;
+  const bool npy = error.empty() && stop_reason != to_string(StopReason::interrupted) &&
+                   c.output_fluid_velocity;
+  std::array<const double*, 3> u{};
+  if (npy) u = sim->stepper().whole_velocity(gathered);
+  on_root([&] {
+    if (error.empty()) io::write_file_atomic(dir.final_state(), io::final_state_csv(sim->rod()));
+    if (npy) io::write_velocity_npy(dir.velocity(), c.grid_n, u[0], u[1], u[2]);
+    io::write_file_atomic(dir.summary(),
+                          summary_json(user, r, meta, files->frames(), stop_reason, error));
+  });
+}
+
+// The blow-up guard: stop with a diagnosis, keep the last good checkpoint.
+void Run::State::blow_up(const std::string& what) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "run: blow-up at step %lld (t = %.6g µs): ",
+                static_cast<long long>(sim->step_count()), sim->time() / 1e-6);
+  std::string msg = buf + what +
+                    ". The time step is probably too large for the stretch/shear stiffness "
+                    "(time.dt_ns = " + format_g(c.time_dt_ns) +
+                    "): try a smaller time.dt_ns, or check the moduli and forces.";
+  if (result.checkpoint_step >= 0)
+    msg += " The last good checkpoint (step " + std::to_string(result.checkpoint_step) +
+           ") is kept in " + dir.checkpoint().string() + ".";
+  try {
+    finish(last_row, to_string(StopReason::blow_up), msg);
+  } catch (const RunError&) {
+    // the blow-up is the error to report
+  }
+  throw RunError(msg);
+}
+
+sim::Observables Run::State::observe_checked() {
+  sim::Observables o = sim->observe();
+  // E_total includes E_K = ½ρΣ|u|²h³, so a NaN/Inf anywhere in the fluid shows here (the rod
+  // itself is checked after every step by rod_problem)
+  if (!std::isfinite(o.E_total_kT))
+    blow_up("the fluid velocity or an energy is not finite (E_total = " +
+            format_g(o.E_total_kT) + " kT, E_K = " + format_g(o.E_kinetic_kT) + " kT)");
+  return o;
+}
+
+void Run::State::check_link(const sim::Observables& o) {
+  const double drift = std::abs(o.link - result.initial.link);
+  meta.max_link_drift = std::max(meta.max_link_drift, drift);
+  if (drift > kLinkDriftWarning && !meta.self_passage_warning) {
+    meta.self_passage_warning = true;
+    meta.self_passage_step = o.step;
+    char buf[320];
+    std::snprintf(buf, sizeof buf,
+                  "ibrod: warning: at step %lld the linking number Lk = %.4f drifted by %.3g from "
+                  "its initial %.4f (more than %.1f): the rod has probably passed through "
+                  "itself (steric.stiffness or steric.diameter_A too small, or Δt too large); "
+                  "recorded in summary.json",
+                  static_cast<long long>(o.step), o.link, o.link - result.initial.link,
+                  result.initial.link, kLinkDriftWarning);
+    say(buf);
+  }
+}
+
+// The time loop: step, check, and write what the Simulation's schedule asks for.
+RunResult Run::State::loop(const SignalGuard& signals) {
+  sim::Simulation& s = *sim;
+  loop_start = Clock::now();
+  start_step = s.step_count();
+  const double ds = c.rod_rise_A;
+  try {
+    ensure_space();
+    if (result.resumed_from < 0) {
+      if (const std::string bad = sim::rod_problem(s.rod(), ds); !bad.empty())
+        blow_up("the initial state is not sane: " + bad);
+      last_row = observe_checked();
+      result.initial = meta.initial = last_row;
+      on_root([&] { files->row(last_row); });
+      write_frame();
+      write_checkpoint(StopReason::none);
+    } else {
+      last_row = s.observe();
+    }
+
+    StopReason reason = StopReason::none;
+    for (;;) {
+      // distributed: the ranks agree on a signal (each may see it after another step)
+      if (const int sig = distributed ? int(mpi::max(signals.pending())) : signals.pending()) {
+        // the end of the current step: save it, then stop
+        if (result.checkpoint_step != s.step_count()) write_checkpoint(StopReason::none);
+        progress.finish_line();
+        result.signal = sig;
+        result.reason = StopReason::interrupted;
+        finish(last_row, to_string(StopReason::interrupted), "");
+        char buf[256];
+        std::snprintf(buf, sizeof buf, "ibrod: interrupted by %s at step %lld (t = %.4f us)",
+                      signal_name(sig), static_cast<long long>(s.step_count()), s.time() / 1e-6);
+        say(buf);
+        return result;
+      }
+      s.step();
+      if (const std::string bad = sim::rod_problem(s.rod(), ds); !bad.empty()) blow_up(bad);
+      const bool output_step = s.output_due();
+      if (output_step) {
+        last_row = observe_checked();
+        on_root([&] { files->row(last_row); });
+        check_link(last_row);
+        reason = s.stop_reason(last_row);
+      }
+      const bool stop = reason != StopReason::none;
+      const bool frame_step = s.frame_due(stop);
+      const bool checkpoint_step = s.checkpoint_due(stop);
+      if (frame_step) write_frame();
+      if (checkpoint_step) write_checkpoint(reason);
+      // before the next step's writes: room for a new checkpoint beside the old one, frames
+      if (!stop && (output_step || frame_step || checkpoint_step)) ensure_space();
+      const double now = seconds_since(loop_start);
+      if (stop) {
+        progress.update(progress_line(last_row), now, /*last=*/true);
+        break;
+      }
+      // the first line at the first output step or after one interval, whichever comes first,
+      // then by the clock (with the latest row: ms/step and ETA are current, the observables are
+      // those of the last output step)
+      if ((output_step && !progress.started()) || progress.due(now))
+        progress.update(progress_line(last_row), now);
+    }
+    result.reason = reason;
+    finish(last_row, to_string(reason), "");
+  } catch (const RunError& e) {
+    // leave a summary that says why the run stopped, if the disk still takes one
+    const std::string what = e.what();
+    if (what.rfind("run: blow-up", 0) != 0) {
+      try {
+        finish(last_row, to_string(StopReason::error), what);
+      } catch (const RunError&) {
+      }
+    }
+    progress.finish_line();
+    throw;
+  }
+
+  char buf[512];
+  std::snprintf(buf, sizeof buf,
+                "ibrod: stopped (%s) after %lld steps, t = %.4f us, Wr = %.4f, Tw = %.4f, "
+                "Lk = %.4f; %.1f s wall, %.3f ms/step",
+                to_string(result.reason).c_str(), static_cast<long long>(result.steps),
+                result.time_us, last_row.writhe, last_row.twist, last_row.link, result.wall_s,
+                result.ms_per_step);
+  say(buf);
+  return result;
+}
+
+Run::Run(const config::Config& c, const RunOptions& opt) {
+  config::validate(c);
+  s_ = std::make_unique<State>(c, opt);
+}
+
+Run::~Run() = default;
+
+RunResult Run::execute() {
+  State& st = *s_;
+  st.check_launch();
+  if (st.opt.resume) {
+    try {
+      st.open_checkpoint();
+    } catch (const AlreadyFinished&) {
+      return st.result;
+    }
+  }
+  st.prepare_directory();
+  // from here a SIGINT/SIGTERM (during FFTW's planning, too) stops the run after a checkpoint
+  const SignalGuard signals(st.opt.handle_signals, SignalGuard::Mode::run);
+  st.build_simulation();
+  st.restore_state();
+  st.open_files();
+  st.announce();
+  return st.loop(signals);
+}
+
+RunResult run(const config::Config& c, const RunOptions& opt) { return Run(c, opt).execute(); }
+
+}  // namespace ibrod::driver

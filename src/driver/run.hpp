@@ -1,0 +1,92 @@
+#pragma once
+// The run driver behind `ibrod run`: output directory, time loop, diagnostics rows, trajectory,
+// checkpoints, progress, final state and summary. Files written into the output directory are
+// named by io::RunDir (docs/outputs.md describes each):
+//   config.toml        the resolved configuration (every key)
+//   timeseries.csv     one row per output step (columns: timeseries_header())
+//   trajectory.h5      H5MD trajectory: frames every output.frame_every_steps, observables, config
+//   rod.pvd, vtk/      ParaView series of the rod (.vtp), with every frame
+//   fluid.pvd          ParaView series of the fluid velocity (.vti; output.fluid_vti)
+//   checkpoint.bin     full state at the latest checkpoint (start, every
+//                      output.checkpoint_every_steps, end, SIGINT/SIGTERM)
+//   fftw.wisdom        the FFTW plans of the run (imported by --resume: same plans, same bits)
+//   final_state.csv    one row per rod point: x_A,y_A,z_A,d1x..d3z
+//   summary.json       steps, simulated time, why it stopped, link drift, observables, timing
+//
+// Continuing a run (--resume) from its checkpoint at step C drops every row and frame after C
+// and recomputes them; the result is bitwise identical to a run that was never interrupted
+// (same plans through fftw.wisdom, the same thread count, deterministic reductions).
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "config/config.hpp"
+#include "io/observables.hpp"
+#include "sim/simulation.hpp"
+
+namespace ibrod::driver {
+
+struct RunOptions {
+  std::string output_dir = "ibrod-out";
+  bool overwrite = false;     ///< replace the files of an existing, non-empty output directory
+  bool resume = false;        ///< continue the run in output_dir from its checkpoint.bin
+  bool force = false;         ///< resume even if the configuration differs from the checkpoint's
+  std::string fftw_wisdom;    ///< import these FFTW plans before planning ("": none)
+  bool handle_signals = true; ///< SIGINT/SIGTERM: checkpoint at the end of the step, then return
+  std::FILE* log = stdout;    ///< progress lines and warnings (nullptr: silent)
+  int tty = -1;               ///< progress style: 1 in place ('\r'), 0 plain lines, −1 isatty(log)
+  /// MPI rank and rank count of MPI_COMM_WORLD (`mpirun -np K ibrod run`, io/mpi_env.hpp): with
+  /// ranks > 1 the fluid grid is split over the ranks (fluid::DistributedFluid), every rank runs
+  /// the rod and the loop, and rank 0 alone writes files and progress. Every rank must call run().
+  int rank = 0;
+  int ranks = 1;
+};
+
+struct RunResult {
+  std::int64_t steps = 0;
+  double time_us = 0;
+  sim::StopReason reason = sim::StopReason::none;
+  sim::Observables initial, final;
+  double wall_s = 0;          ///< this process
+  double ms_per_step = 0;     ///< this process
+  int signal = 0;             ///< SIGINT/SIGTERM that stopped the run after a checkpoint; 0: none
+  bool already_finished = false;  ///< --resume of a run that had stopped: nothing was done
+  std::int64_t resumed_from = -1; ///< checkpoint step this process started from (−1: fresh)
+  std::int64_t checkpoint_step = -1;  ///< step of the latest checkpoint written or read
+  double link_drift = 0;      ///< final Lk − initial Lk
+  double max_link_drift = 0;  ///< max |Lk − Lk(0)| over the output steps
+  bool self_passage_warning = false;  ///< max_link_drift > kLinkDriftWarning
+};
+
+/// |Lk − Lk(0)| beyond which a run warns (once) of a likely self-passage.
+inline constexpr double kLinkDriftWarning = 0.1;
+
+/// One trajectory from its configuration to its final files: prepares the output directory (or
+/// checks the checkpoint to continue from), builds the Simulation, runs its time loop — writing
+/// rows, frames and checkpoints when the Simulation's schedule says so, watching for blow-ups
+/// and signals, printing progress — and writes the final state and summary.json.
+///
+///   Run r(config, options);   // validates; nothing written yet
+///   RunResult result = r.execute();
+///
+/// Under MPI (options.ranks > 1) every rank constructs a Run and calls execute(); rank 0 alone
+/// writes files and progress. execute() throws ConfigError (bad config, output directory
+/// exists, unusable checkpoint) or RunError (blow-up, I/O failure: disk full, …); a SIGINT or
+/// SIGTERM does not throw: the result has `signal` set.
+class Run {
+ public:
+  Run(const config::Config& c, const RunOptions& opt);
+  ~Run();
+  Run(const Run&) = delete;
+  Run& operator=(const Run&) = delete;
+  RunResult execute();
+
+ private:
+  struct State;
+  std::unique_ptr<State> s_;
+};
+
+/// Run(c, opt).execute().
+RunResult run(const config::Config& c, const RunOptions& opt);
+
+}  // namespace ibrod::driver

@@ -1,0 +1,138 @@
+#pragma once
+// The files of a run directory that grow while it runs — timeseries.csv, trajectory.h5, rod.pvd
+// (+ fluid.pvd) — and the ones written at its end (summary.json); driver::Run's writers.
+#include <cerrno>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "config/config.hpp"
+#include "core/error.hpp"
+#include "core/text_file.hpp"
+#include "driver/progress.hpp"
+#include "driver/run.hpp"
+#include "io/atomic_file.hpp"
+#include "io/checkpoint.hpp"
+#include "io/csv.hpp"
+#include "io/h5md.hpp"
+#include "io/observables.hpp"
+#include "io/run_dir.hpp"
+#include "io/vtk.hpp"
+#include "sim/simulation.hpp"
+
+namespace ibrod::driver {
+
+/// Makes the output directory of a fresh run: refuses a non-directory or (without overwrite) a
+/// directory that holds files; with overwrite removes every file an earlier run left
+/// (RunDir::run_files), so that stale frames or checkpoints never mix with the new run.
+void prepare_output_dir(const io::RunDir& dir, bool overwrite);
+
+/// summary.json of a run that stopped (stop_reason) or failed (error non-empty).
+std::string summary_json(const config::Config& c, const RunResult& r,
+                         const io::CheckpointMeta& meta, std::int64_t frames,
+                         const std::string& stop_reason, const std::string& error);
+
+// Only rank 0 of a distributed run holds one.
+class RunFiles {
+ public:
+  // resume_step < 0: a fresh run (create everything); otherwise continue the files, dropping
+  // rows and frames after resume_step.
+  RunFiles(const io::RunDir& dir, const config::Config& c, const sim::Simulation& sim,
+           std::int64_t resume_step, const std::string& config_text, Progress& progress)
+      : dir_(dir),
+        ds_(c.rod_rise_A),
+        vti_(c.output_fluid_vti),
+        frames_on_(sim.params().output.frames > 0),
+        rod_pvd_(dir.root(), io::RunDir::kRodSeries, "vtp"),
+        fluid_pvd_(dir.root(), io::RunDir::kFluidSeries, "vti") {
+    const std::filesystem::path ts = dir.timeseries();
+    const int n = sim.rod().size();
+    if (resume_step < 0) {
+      io::write_file_atomic(ts, io::timeseries_header() + "\n");
+      if (frames_on_)
+        h5_ = io::H5mdWriter::create(dir.trajectory(), n, c.grid_box_A, config_text);
+    } else {
+      io::write_file_atomic(ts, io::timeseries_up_to(try_read_text_file(ts).value_or(""),
+                                             io::timeseries_header(), resume_step, ts.string()));
+      if (frames_on_) reopen_trajectory(dir.trajectory(), n, c.grid_box_A, resume_step,
+                                        config_text, progress);
+      if (frames_on_) rod_pvd_.resume(resume_step);
+      if (frames_on_ && vti_) fluid_pvd_.resume(resume_step);
+    }
+    ts_ = std::fopen(ts.c_str(), "a");
+    if (!ts_) throw RunError("output: cannot open " + ts.string() + ": " + io::io_error_text(errno));
+  }
+  ~RunFiles() {
+    if (ts_) std::fclose(ts_);
+  }
+  RunFiles(const RunFiles&) = delete;
+  RunFiles& operator=(const RunFiles&) = delete;
+
+  /// Throws RunError if the device of the output directory has less than `bytes` free: a full
+  /// disk is better met before a write than in the middle of one (HDF5 cannot always recover a
+  /// file whose write failed half-way).
+  void ensure_space(std::uintmax_t bytes) const {
+    std::error_code ec;
+    const std::filesystem::space_info space = std::filesystem::space(dir_.root(), ec);
+    if (!ec && space.available < bytes)
+      throw RunError("output: only " + std::to_string(space.available >> 20) + " MiB left on the "
+                     "device of " + dir_.root().string() + " (disk full?); stopped before writing, so "
+                     "every file is intact: free space and continue with --resume " +
+                     dir_.root().string());
+  }
+
+  void row(const sim::Observables& o) {
+    // flushed row by row: a killed run loses nothing already computed
+    if (std::fprintf(ts_, "%s\n", io::timeseries_row(o).c_str()) < 0 || std::fflush(ts_) != 0)
+      throw RunError("output: cannot write " + dir_.timeseries().string() + ": " +
+                     io::io_error_text(errno));
+    if (h5_) h5_->write_observables(o);
+  }
+
+  // u: the whole fluid velocity (Stepper::whole_velocity), read only with output.fluid_vti
+  void frame(const sim::Simulation& sim, std::array<const double*, 3> u) {
+    if (!frames_on_) return;
+    const double t_us = sim.time() / 1e-6;
+    h5_->write_frame(sim.step_count(), t_us, sim.rod());
+    rod_pvd_.add(sim.step_count(), t_us, io::rod_vtp(sim.rod(), ds_));
+    if (vti_) fluid_pvd_.add(sim.step_count(), t_us, io::fluid_vti(sim.params().stepper.grid, u));
+  }
+
+  std::int64_t frames() const { return h5_ ? h5_->frames() : 0; }
+
+ private:
+  io::RunDir dir_;
+  double ds_;
+  bool vti_, frames_on_;
+  std::FILE* ts_ = nullptr;
+  std::unique_ptr<io::H5mdWriter> h5_;
+  io::PvdSeries rod_pvd_, fluid_pvd_;
+
+  void reopen_trajectory(const std::filesystem::path& path, int n, double box_A, std::int64_t last,
+                         const std::string& config_text, Progress& progress) {
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) {
+      h5_ = io::H5mdWriter::create(path, n, box_A, config_text);
+      return;
+    }
+    try {
+      h5_ = io::H5mdWriter::reopen(path, n, last, config_text);
+    } catch (const RunError& e) {
+      // a run killed in the middle of an HDF5 write can leave the file unreadable: keep it for
+      // inspection and start a new one, rather than refuse to resume
+      const std::filesystem::path aside = dir_.damaged_trajectory(last);
+      std::filesystem::rename(path, aside, ec);
+      progress.message(std::string("ibrod: warning: ") + e.what() + "; moved it to " +
+                       aside.string() + "; trajectory.h5 restarts at step " +
+                       std::to_string(last + 1));
+      h5_ = io::H5mdWriter::create(path, n, box_A, config_text);
+    }
+  }
+};
+
+// ---------------------------------------------------------------------------------------------
+
+
+}  // namespace ibrod::driver

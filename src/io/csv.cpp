@@ -1,0 +1,115 @@
+#include "io/csv.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "core/text_file.hpp"
+
+namespace ibrod::io {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::vector<std::string> split(const std::string& line, char sep) {
+  std::vector<std::string> out;
+  std::string field;
+  std::istringstream in(line);
+  while (std::getline(in, field, sep)) out.push_back(field);
+  if (!line.empty() && line.back() == sep) out.emplace_back();
+  return out;
+}
+
+}  // namespace
+
+bool parse_double(const std::string& s, double& v) {
+  if (s.empty()) return false;
+  char* end = nullptr;
+  errno = 0;
+  v = std::strtod(s.c_str(), &end);
+  while (end && (*end == ' ' || *end == '\r')) ++end;
+  return end && *end == '\0' && s.c_str() != end;
+}
+
+bool CsvTable::has(const std::string& name) const {
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+std::span<const double> CsvTable::column(const std::string& name) const {
+  const auto it = std::find(names.begin(), names.end(), name);
+  if (it == names.end())
+    throw ConfigError("'" + path.string() + "' has no column '" + name + "'");
+  return columns[std::size_t(it - names.begin())];
+}
+
+CsvTable read_csv_table(const fs::path& path) {
+  const std::string text = read_text_file(path, "csv");
+  CsvTable t;
+  t.path = path;
+  std::istringstream in(text);
+  std::string line;
+  if (!std::getline(in, line)) throw ConfigError("'" + path.string() + "' is empty");
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  t.names = split(line, ',');
+  t.columns.assign(t.names.size(), {});
+  const bool ends_in_newline = !text.empty() && text.back() == '\n';
+  std::size_t lineno = 1;
+  while (std::getline(in, line)) {
+    ++lineno;
+    if (line.empty() || line == "\r") continue;
+    const auto fields = split(line, ',');
+    std::vector<double> v(fields.size());
+    bool ok = fields.size() == t.names.size();
+    for (std::size_t k = 0; ok && k < fields.size(); ++k) ok = parse_double(fields[k], v[k]);
+    if (!ok) {
+      if (in.peek() == EOF && !ends_in_newline) break;  // a row cut short by a killed run
+      throw ConfigError("'" + path.string() + "' line " + std::to_string(lineno) + ": expected " +
+                        std::to_string(t.names.size()) + " numbers, got '" + line + "'");
+    }
+    for (std::size_t k = 0; k < v.size(); ++k) t.columns[k].push_back(v[k]);
+  }
+  return t;
+}
+
+std::string final_state_csv(const rod::RodState& s) {
+  std::string out = "x_A,y_A,z_A,d1x,d1y,d1z,d2x,d2y,d2z,d3x,d3y,d3z\n";
+  char buf[512];
+  for (int k = 0; k < s.size(); ++k) {
+    const Vec3& x = s.X[k];
+    const Mat3& D = s.D[k];
+    std::snprintf(buf, sizeof buf,
+                  "%.12g,%.12g,%.12g,%.15g,%.15g,%.15g,%.15g,%.15g,%.15g,%.15g,%.15g,%.15g\n", x[0],
+                  x[1], x[2], D(0, 0), D(1, 0), D(2, 0), D(0, 1), D(1, 1), D(2, 1), D(0, 2),
+                  D(1, 2), D(2, 2));
+    out += buf;
+  }
+  return out;
+}
+
+std::string timeseries_up_to(const std::string& text, const std::string& header,
+                             std::int64_t last_step, const std::string& source) {
+  std::string out = header + "\n";
+  std::size_t pos = text.find('\n');
+  if (pos != std::string::npos && text.substr(0, pos) != header)
+    throw RunError("resume: " + source +
+                   " has other columns than this ibrod writes; move it away to resume");
+  std::int64_t prev = -1;
+  while (pos != std::string::npos && pos + 1 < text.size()) {
+    const std::size_t end = text.find('\n', pos + 1);
+    if (end == std::string::npos) break;  // an incomplete last line (killed mid-write)
+    const std::string line = text.substr(pos + 1, end - pos - 1);
+    pos = end;
+    char* stop = nullptr;
+    const long long step = std::strtoll(line.c_str(), &stop, 10);
+    if (stop == line.c_str() || *stop != ',' || step > last_step || step <= prev) continue;
+    prev = step;
+    out += line + "\n";
+  }
+  return out;
+}
+
+}  // namespace ibrod::io

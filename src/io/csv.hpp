@@ -1,0 +1,45 @@
+#pragma once
+// The run directory's CSV files: one reader (CsvTable: timeseries.csv, final_state.csv) and the
+// writers of final_state.csv and of a time series cut back to a checkpoint's step.
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "rod/rod.hpp"
+
+namespace ibrod::io {
+
+/// A CSV file with a header row and numeric fields, by column.
+struct CsvTable {
+  std::filesystem::path path;
+  std::vector<std::string> names;
+  std::vector<std::vector<double>> columns;  ///< [names.size()][rows]
+
+  std::size_t rows() const { return columns.empty() ? 0 : columns.front().size(); }
+  bool has(const std::string& name) const;
+  /// The column called `name`; ConfigError naming the file if there is none.
+  std::span<const double> column(const std::string& name) const;
+};
+
+/// Reads a CSV file of numbers with a header row (timeseries.csv, final_state.csv). A final line
+/// cut short (a run killed while writing it) is dropped; any other malformed line throws
+/// ConfigError naming the file and line.
+CsvTable read_csv_table(const std::filesystem::path& path);
+
+/// A whole field as a number (surrounding blanks and a trailing '\r' allowed): false if it is
+/// empty or not entirely a number.
+bool parse_double(const std::string& s, double& v);
+
+/// final_state.csv: the header x_A,y_A,z_A,d1x,d1y,d1z,d2x,d2y,d2z,d3x,d3y,d3z and one row per
+/// rod point (positions to 12 significant digits, triad columns D¹, D², D³ to 15).
+std::string final_state_csv(const rod::RodState& s);
+
+/// timeseries.csv cut back to the rows with step <= last_step, in increasing step order, after
+/// `header` (an incomplete last line — a run killed while writing it — and any row out of order
+/// are dropped). Throws RunError if `text`'s header is not `header`.
+std::string timeseries_up_to(const std::string& text, const std::string& header,
+                             std::int64_t last_step, const std::string& source);
+
+}  // namespace ibrod::io

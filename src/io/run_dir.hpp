@@ -1,0 +1,56 @@
+#pragma once
+// The names of every file of a run directory, in one place (docs/outputs.md describes each):
+//   config.toml        the resolved configuration (every key)
+//   timeseries.csv     one row per output step (io/observables.hpp: timeseries_header())
+//   trajectory.h5      H5MD trajectory: frames, observables, config (io/h5md.hpp)
+//   rod.pvd, vtk/      ParaView series of the rod (.vtp), with every frame (io/vtk.hpp)
+//   fluid.pvd          ParaView series of the fluid velocity (.vti; output.fluid_vti)
+//   checkpoint.bin     the full state at the latest checkpoint (io/checkpoint.hpp)
+//   fftw.wisdom        the FFTW plans of the run (imported by --resume: same plans, same bits)
+//   final_state.csv    one row per rod point (io/csv.hpp: final_state_csv())
+//   summary.json       steps, simulated time, why it stopped, link drift, observables, timing
+//   velocity.npy       the final fluid velocity (output.fluid_velocity; io/npy.hpp)
+//   render/            pictures of `ibrod render`
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace ibrod::io {
+
+class RunDir {
+ public:
+  explicit RunDir(std::filesystem::path root) : root_(std::move(root)) {}
+  const std::filesystem::path& root() const { return root_; }
+
+  std::filesystem::path config() const { return root_ / "config.toml"; }
+  std::filesystem::path timeseries() const { return root_ / "timeseries.csv"; }
+  std::filesystem::path trajectory() const { return root_ / "trajectory.h5"; }
+  /// where a trajectory.h5 that cannot be reopened on resume is moved (kept for inspection)
+  std::filesystem::path damaged_trajectory(std::int64_t step) const {
+    return root_ / ("trajectory.damaged-" + std::to_string(step) + ".h5");
+  }
+  std::filesystem::path checkpoint() const { return root_ / "checkpoint.bin"; }
+  std::filesystem::path wisdom() const { return root_ / "fftw.wisdom"; }
+  std::filesystem::path final_state() const { return root_ / "final_state.csv"; }
+  std::filesystem::path summary() const { return root_ / "summary.json"; }
+  std::filesystem::path velocity() const { return root_ / "velocity.npy"; }
+  std::filesystem::path render_dir() const { return root_ / "render"; }
+  /// the ParaView series: "<prefix>.pvd" and vtk/<prefix>_<step>.<ext>
+  static constexpr const char* kRodSeries = "rod";
+  static constexpr const char* kFluidSeries = "fluid";
+  static constexpr const char* kVtkDir = "vtk";
+
+  /// Every file and folder a run writes (what --overwrite removes before a new run).
+  std::vector<std::filesystem::path> run_files() const {
+    return {config(),      timeseries(),  trajectory(), root_ / "rod.pvd",
+            root_ / "fluid.pvd", checkpoint(), wisdom(), final_state(),
+            summary(),     velocity(),    root_ / kVtkDir};
+  }
+
+ private:
+  std::filesystem::path root_;
+};
+
+}  // namespace ibrod::io

@@ -1,0 +1,39 @@
+#include "sim/rod_problem.hpp"
+
+#include <cstdio>
+
+namespace ibrod::sim {
+
+std::string rod_problem(const rod::RodState& s, double ds) {
+  const int n = s.size();
+  char buf[256];
+  for (int k = 0; k < n; ++k) {
+    if (!s.X[k].allFinite()) {
+      std::snprintf(buf, sizeof buf, "the position of point %d is not finite (%g, %g, %g) Å", k,
+                    s.X[k][0], s.X[k][1], s.X[k][2]);
+      return buf;
+    }
+    if (!s.D[k].allFinite()) return "the triad of point " + std::to_string(k) + " is not finite";
+  }
+  for (int k = 0; k < n; ++k) {
+    const int k1 = k + 1 == n ? 0 : k + 1;
+    const double r = (s.X[k1] - s.X[k]).norm() / ds;
+    if (!(r >= 0.5 && r <= 1.5)) {
+      std::snprintf(buf, sizeof buf,
+                    "the spacing of points %d and %d is %.4g Δs (allowed: 0.5 to 1.5 Δs)", k, k1, r);
+      return buf;
+    }
+  }
+  for (int k = 0; k < n; ++k) {
+    const double e = (s.D[k].transpose() * s.D[k] - Mat3::Identity()).cwiseAbs().maxCoeff();
+    if (!(e <= 1e-3)) {
+      std::snprintf(buf, sizeof buf,
+                    "the triad of point %d is off orthonormal by %.3g (max |DᵀD − I|; allowed 1e-3)",
+                    k, e);
+      return buf;
+    }
+  }
+  return {};
+}
+
+}  // namespace ibrod::sim

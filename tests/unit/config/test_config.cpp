@@ -1,0 +1,133 @@
+// Config: defaults are MODEL §1's reference table, conversions to internal units, and every kind
+// of bad input is a ConfigError naming the key.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "core/error.hpp"
+#include "config/config.hpp"
+
+using namespace ibrod;
+using ::testing::HasSubstr;
+
+namespace {
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(Config, DefaultsAreTheReferenceTableInInternalUnits) {
+  const config::Config c;
+  config::validate(c);
+  const auto p = config::to_params(c);
+  EXPECT_EQ(p.stepper.grid.n, 64);
+  EXPECT_DOUBLE_EQ(p.stepper.grid.L, 725.0);
+  EXPECT_DOUBLE_EQ(p.stepper.fluid.dt, 1e-10);
+  EXPECT_NEAR(p.stepper.fluid.density, 1e-24, 1e-38);
+  EXPECT_NEAR(p.stepper.fluid.viscosity, 1e-10, 1e-24);
+  EXPECT_NEAR(p.stepper.rod.a[0], 1.3e5, 1e-9);
+  EXPECT_NEAR(p.stepper.rod.a[2], 1.82e5, 1e-9);
+  EXPECT_NEAR(p.stepper.rod.b[0], 5e3, 1e-10);
+  EXPECT_NEAR(p.stepper.rod.b[2], 5e3, 1e-10);
+  EXPECT_EQ(p.stepper.rod.n, 600);
+  EXPECT_DOUBLE_EQ(p.stepper.rod.ds, 3.4);
+  EXPECT_NEAR(p.kT, 414.2, 0.05);
+  EXPECT_NEAR(p.stepper.electro.law.kappa, 0.10404, 1e-5);  // MODEL §1: 0.329 √0.1
+  EXPECT_EQ(p.circle.excess_link, 6);
+  ASSERT_EQ(p.circle.perturbation.size(), 1u);
+  EXPECT_EQ(p.circle.perturbation[0], 1.0);
+  EXPECT_NEAR(p.stop_kinetic, 1e-12 * p.kT, 1e-20);
+}
+
+TEST(Config, OverridesAreTyped) {
+  config::Config c;
+  config::apply_override(c, "grid.n=32");
+  config::apply_override(c, "rod.perturbation=[0.5, 0, 0.25]");
+  config::apply_override(c, "electrostatics.enabled=false");
+  config::apply_override(c, "rod.excess_link=2.0");  // an integral float is an integer
+  EXPECT_EQ(c.grid_n, 32);
+  EXPECT_EQ(c.rod_perturbation, (std::vector<double>{0.5, 0.0, 0.25}));
+  EXPECT_FALSE(c.electrostatics_enabled);
+  EXPECT_EQ(c.rod_excess_link, 2);
+}
+
+TEST(Config, BadValuesNameTheKeyTheValueAndWhatIsAllowed) {
+  config::Config c;
+  auto msg = error_of([&] { config::apply_override(c, "grid.kernel_width=1.5"); });
+  EXPECT_THAT(msg, HasSubstr("grid.kernel_width"));
+  EXPECT_THAT(msg, HasSubstr("1.5"));
+  EXPECT_THAT(msg, HasSubstr("integer"));
+  msg = error_of([&] { config::apply_override(c, "solvent.viscosity_poise=-0.01"); });
+  EXPECT_THAT(msg, HasSubstr("solvent.viscosity_poise"));
+  EXPECT_THAT(msg, HasSubstr("> 0"));
+  msg = error_of([&] { config::apply_override(c, "rod.excess_link=2.5"); });
+  EXPECT_THAT(msg, HasSubstr("rod.excess_link"));
+  msg = error_of([&] { config::apply_override(c, "rod.base_pairs=0"); });
+  EXPECT_THAT(msg, HasSubstr("rod.base_pairs"));
+  msg = error_of([&] { config::apply_override(c, "rod.base_pairs=-5"); });
+  EXPECT_THAT(msg, HasSubstr("rod.base_pairs"));
+  msg = error_of([&] { config::apply_override(c, "grid.n=\"big\""); });
+  EXPECT_THAT(msg, HasSubstr("grid.n"));
+  msg = error_of([&] { config::apply_override(c, "steric.enabled=1"); });
+  EXPECT_THAT(msg, HasSubstr("true or false"));
+  msg = error_of([&] { config::apply_override(c, "rod.perturbation=[1, \"x\"]"); });
+  EXPECT_THAT(msg, HasSubstr("rod.perturbation"));
+  msg = error_of([&] { config::apply_override(c, "time.dt_ns=nan"); });
+  EXPECT_THAT(msg, HasSubstr("time.dt_ns"));
+}
+
+TEST(Config, UnknownKeysAndSectionsAreErrors) {
+  config::Config c;
+  auto msg = error_of([&] { config::apply_override(c, "grid.nn=64"); });
+  EXPECT_THAT(msg, HasSubstr("unknown key 'grid.nn'"));
+  EXPECT_THAT(msg, HasSubstr("kernel_width"));  // lists the keys that exist
+  msg = error_of([&] { config::apply_toml(c, "[gird]\nn = 64\n", "t.toml"); });
+  EXPECT_THAT(msg, HasSubstr("gird.n"));
+  msg = error_of([&] { config::apply_toml(c, "n = 64\n", "t.toml"); });
+  EXPECT_THAT(msg, HasSubstr("must be a section"));
+  msg = error_of([&] { config::apply_override(c, "novalue"); });
+  EXPECT_THAT(msg, HasSubstr("section.key=value"));
+}
+
+TEST(Config, BrokenTomlReportsTheLine) {
+  config::Config c;
+  const auto msg = error_of([&] { config::apply_toml(c, "[grid]\nn = 64\nbox_A = = 3\n", "bad.toml"); });
+  EXPECT_THAT(msg, HasSubstr("bad.toml:3"));
+  EXPECT_THAT(msg, HasSubstr("TOML"));
+}
+
+TEST(Config, CrossKeyValidation) {
+  config::Config c;
+  c.grid_n = 63;
+  EXPECT_THAT(error_of([&] { config::validate(c); }), HasSubstr("grid.n"));
+  c = config::Config{};
+  c.grid_box_A = 500;  // the 649 Å ring does not fit
+  EXPECT_THAT(error_of([&] { config::validate(c); }), HasSubstr("grid.box_A"));
+  c = config::Config{};
+  c.grid_n = 16;
+  c.grid_kernel_width = 4;  // 18 stencil points > 16
+  EXPECT_THAT(error_of([&] { config::validate(c); }), HasSubstr("grid.kernel_width"));
+  c = config::Config{};
+  c.rod_base_pairs = 10;
+  c.rod_excess_link = 1000;  // |sin β| > 1
+  c.grid_box_A = 100;
+  EXPECT_THAT(error_of([&] { config::validate(c); }), HasSubstr("rod.excess_link"));
+}
+
+TEST(Config, ResolvedTomlRoundTrips) {
+  config::Config c;
+  config::apply_override(c, "grid.n=32");
+  config::apply_override(c, "rod.perturbation=[0.5, 0.25]");
+  config::apply_override(c, "solvent.salt_M=0.01");
+  config::apply_override(c, "output.every_steps=7");
+  config::Config d;
+  config::apply_toml(d, config::to_toml(c), "resolved");
+  EXPECT_EQ(config::describe(c), config::describe(d));
+  EXPECT_NE(config::describe(c), config::describe(config::Config{}));
+}
