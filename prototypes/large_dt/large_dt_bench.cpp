@@ -4,7 +4,8 @@
 // reference step; its stability limit is ~0.22 ns); the implicit one runs `implicit_ns` of
 // simulated time with the adaptive controller at Δt ≤ `dt_max_ns`. Last line:
 //   us_per_hour_explicit=… us_per_hour_implicit=…
-// Usage: large_dt_bench [dt_max_ns=2] [implicit_ns=200] [explicit_steps=300] [section.key=value…]
+// Usage: large_dt_bench [dt_max_ns=2] [implicit_ns=200] [explicit_steps=300] [beta=8]
+//        [jac_every=N (default: ImplicitParams's)] [section.key=value…]
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -18,7 +19,8 @@ using namespace ibrod;
 
 int main(int argc, char** argv) {
   std::map<std::string, std::string> kv{
-      {"dt_max_ns", "2"}, {"implicit_ns", "200"}, {"explicit_steps", "300"}, {"beta", "8"}};
+      {"dt_max_ns", "2"}, {"implicit_ns", "200"}, {"explicit_steps", "300"}, {"beta", "8"},
+      {"jac_every", "0"}};
   config::Config cfg;
   config::apply_override(cfg, "run.threads=2");
   for (int i = 1; i < argc; ++i) {
@@ -55,6 +57,7 @@ int main(int argc, char** argv) {
     integrate::Stepper st(p.stepper);
     integrate::ImplicitParams ip;
     ip.mobility_scale = std::stod(kv["beta"]);
+    if (std::stoi(kv["jac_every"]) > 0) ip.jacobian_every = std::stoi(kv["jac_every"]);
     integrate::ImplicitStepper imp(st, ip);
     integrate::AdaptiveDtParams ap;
     ap.dt_max = std::stod(kv["dt_max_ns"]) * 1e-9;

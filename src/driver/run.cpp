@@ -221,6 +221,8 @@ void Run::State::restore_state() {
     // checkpoints from before time was state: step × Δt of the run that wrote them
     const double time = meta.time_s >= 0 ? meta.time_s : double(meta.step) * sim->dt();
     sim->restore_clock(meta.step, time);
+    if (meta.implicit_next_dt_s > 0)
+      sim->restore_implicit_state({meta.implicit_next_dt_s, meta.implicit_accepted_in_a_row});
     result.initial = meta.initial;
     result.resumed_from = result.checkpoint_step = meta.step;
     checkpoint.reset();  // the state lives in sim now; free the copy
@@ -289,6 +291,12 @@ void Run::State::write_frame() {
 void Run::State::write_checkpoint(StopReason reason) {
   meta.step = sim->step_count();
   meta.time_s = sim->time();
+  if (sim->implicit()) {
+    const auto st = sim->implicit_state();
+    meta.implicit_next_dt_s = st.next_dt;
+    meta.implicit_accepted_in_a_row = st.accepted_in_a_row;
+    sim->checkpoint_taken();  // the resumed run starts the same way (bitwise resume)
+  }
   meta.stop_reason = to_string(reason);
   meta.wall_s = wall_before + seconds_since(t0);
   const auto u = sim->stepper().whole_velocity(gathered);

@@ -38,10 +38,12 @@ struct ImplicitParams {
   double mobility_scale = 2.0;   ///< β: M_loc = β × the kernel's self mobility (≥ 0)
   int krylov_max_iter = 0;       ///< GMRES iterations after the IMEX guess (0: scheme (2))
   double krylov_tol = 1e-2;      ///< relative residual of (1) at which GMRES stops
-  /// trial steps between refreshes of K and of the factorisation (≥ 1; K at qⁿ when refreshed;
-  /// also refreshed when Δt changes the factorisation anyway). 4: at the 64³ reference
-  /// 3.9 against 7.3 ms per step, the same accuracy (docs/large_dt.md)
-  int jacobian_every = 4;
+  /// trial steps between refreshes of K and of its factorisation (≥ 1; K at qⁿ when refreshed,
+  /// and whenever Δt changes). 1: K is a function of the state alone, so a run resumed from any
+  /// checkpoint (a signal's too) is bitwise the same. > 1 saves ~1.4 ms per step at the 64³
+  /// reference (4: 5.3–5.5 against 7.0–7.1 ms, the same accuracy; docs/large_dt.md), and then
+  /// only resumes from the periodic checkpoints are bitwise (Simulation::checkpoint_taken).
+  int jacobian_every = 1;
   bool velocity_form = true;     ///< (I + Δt M_loc K) u = M F (true) or (I + Δt K M_loc) g = F
   bool gauss_newton = true;      ///< K = Δs Σ Jᵀ C J (positive semi-definite) instead of −∂F/∂q
   bool stiffness_fd = false;     ///< Gauss–Newton K by finite differences (else small-strain
