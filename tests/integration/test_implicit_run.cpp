@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 #include "io/checkpoint.hpp"
@@ -89,4 +90,26 @@ TEST(ImplicitRun, ReachesTheEndWithAnAdaptiveStepAndResumesBitwise) {
   EXPECT_EQ(slurp(root / "A" / "timeseries.csv"), slurp(b / "timeseries.csv"));
   EXPECT_EQ(slurp(root / "A" / "final_state.csv"), slurp(b / "final_state.csv"));
   if (!HasFailure()) fs::remove_all(root);
+}
+
+TEST(ImplicitRun, BenchSchemesEndsWithBothRates) {
+  const fs::path root = fresh_dir("bench_schemes");
+  const Exit e = run_ibrod({"bench", "--schemes", "--steps", "40", "--implicit-ns", "40",
+                            "--set", "grid.n=16", "--set", "grid.box_A=200", "--set",
+                            "rod.base_pairs=100", "--set", "run.fftw_measure=false", "--set",
+                            "run.threads=1"},
+                           root / "bench.log");
+  ASSERT_EQ(e.code, 0) << e.output;
+  const std::string out = e.output;
+  const auto pos = out.rfind("us_per_hour_explicit=");
+  ASSERT_NE(pos, std::string::npos) << out;
+  double ex = 0, im = 0;
+  ASSERT_EQ(std::sscanf(out.c_str() + pos, "us_per_hour_explicit=%lf us_per_hour_implicit=%lf",
+                        &ex, &im),
+            2)
+      << out;
+  EXPECT_GT(ex, 0.0);
+  EXPECT_GT(im, ex);  // 20× the step at a cost of about one explicit step each
+  EXPECT_EQ(out.find('\n', pos), out.size() - 1) << "not the last line:\n" << out;
+  fs::remove_all(root);
 }
