@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 
@@ -52,10 +53,10 @@ std::vector<int> colouring(int n) {
 // segments in contact (closest points P(s), Q(t) at d < D along u), the linearisation of
 // g (D − d) u with s, t and u frozen, g w wᵀ ⊗ u uᵀ, w = (1 − s, s, −(1 − t), −t) over the
 // end points (X_k, X_{k+1}, X_l, X_{l+1}): positive semi-definite. (The transverse term
-// −g (D − d)/d (I − u uᵀ), small at small overlap and destabilising, is left out.) O(n²) over
-// segment pairs with a midpoint test, as Steric::accumulate_direct.
+// −g (D − d)/d (I − u uᵀ), small at small overlap and destabilising, is left out.) Candidate
+// segment pairs from a cell grid over the midpoints; trip = nullptr: count the contacts only.
 int add_steric_stiffness(const interactions::StericParams& p, std::span<const Vec3> X,
-                         std::vector<Eigen::Triplet<double>>& trip) {
+                         std::vector<Eigen::Triplet<double>>* trip) {
   const int n = int(X.size());
   if (!p.enabled || n < 4 || !(p.diameter > 0) || !(p.stiffness > 0)) return 0;
   std::vector<Vec3> mid(n);
@@ -65,16 +66,40 @@ int add_steric_stiffness(const interactions::StericParams& p, std::span<const Ve
     lmax2 = std::max(lmax2, (X[(k + 1) % n] - X[k]).squaredNorm());
   }
   const double reach = p.diameter + std::sqrt(lmax2);
-  int contacts = 0;
+  // candidates from a grid of cells of edge `reach` over the midpoints (sorted by cell key):
+  // for each k, the partners l > k in the 27 cells around it, in ascending order
+  auto cell = [&](const Vec3& x, int d) { return std::int64_t(std::floor(x[d] / reach)); };
+  auto key = [](std::int64_t i, std::int64_t j, std::int64_t k) {
+    return ((i & 0x1FFFFF) << 42) | ((j & 0x1FFFFF) << 21) | (k & 0x1FFFFF);
+  };
+  std::vector<std::pair<std::int64_t, int>> sorted(n);
   for (int k = 0; k < n; ++k)
-    for (int l = k + 1; l < n; ++l) {
-      const int m = l - k;
-      if (!(std::min(m, n - m) * p.ds > 2 * p.diameter)) continue;
+    sorted[k] = {key(cell(mid[k], 0), cell(mid[k], 1), cell(mid[k], 2)), k};
+  std::sort(sorted.begin(), sorted.end());
+  int contacts = 0;
+  std::vector<int> partners;
+  for (int k = 0; k < n; ++k) {
+    partners.clear();
+    const std::int64_t ci = cell(mid[k], 0), cj = cell(mid[k], 1), ck = cell(mid[k], 2);
+    for (std::int64_t di = -1; di <= 1; ++di)
+      for (std::int64_t dj = -1; dj <= 1; ++dj)
+        for (std::int64_t dk = -1; dk <= 1; ++dk) {
+          const std::int64_t q = key(ci + di, cj + dj, ck + dk);
+          auto it = std::lower_bound(sorted.begin(), sorted.end(), std::make_pair(q, -1));
+          for (; it != sorted.end() && it->first == q; ++it) {
+            const int l = it->second, m = l - k;
+            // more than 2D apart along the rod (MODEL (2.17)), as Steric
+            if (l > k && std::min(m, n - m) * p.ds > 2 * p.diameter) partners.push_back(l);
+          }
+        }
+    std::sort(partners.begin(), partners.end());
+    for (const int l : partners) {
       if ((mid[k] - mid[l]).squaredNorm() >= reach * reach) continue;
       const int k1 = (k + 1) % n, l1 = (l + 1) % n;
       const auto c = interactions::closest_points(X[k], X[k1], X[l], X[l1]);
       if (!(c.d < p.diameter) || !(c.d > 0)) continue;
       ++contacts;
+      if (!trip) continue;
       const Vec3 u = c.sep / c.d;
       const Mat3 uu = p.stiffness * u * u.transpose();
       const int idx[4] = {k, k1, l, l1};
@@ -83,8 +108,9 @@ int add_steric_stiffness(const interactions::StericParams& p, std::span<const Ve
         for (int b = 0; b < 4; ++b)
           for (int r = 0; r < 3; ++r)
             for (int q = 0; q < 3; ++q)
-              trip.emplace_back(6 * idx[a] + r, 6 * idx[b] + q, w[a] * w[b] * uu(r, q));
+              trip->emplace_back(6 * idx[a] + r, 6 * idx[b] + q, w[a] * w[b] * uu(r, q));
     }
+  }
   return contacts;
 }
 
@@ -124,47 +150,59 @@ void ImplicitStepper::mobility(std::span<const Vec3> X, std::span<const Vec3> F,
   pc.finish_interpolation(U, W);
 }
 
+void ImplicitStepper::gn_blocks(const rod::RodState& s) {
+  // Gauss–Newton with the small-strain strain Jacobian of half point h (between k and k+1,
+  // triad D_h = [D¹ D² D³], X′ = (X_{k+1} − X_k)/Δs), MODEL §4 step 2 linearised:
+  //   δΓ_i = D^i·(δX_{k+1} − δX_k)/Δs + ½ (D^i × X′)·(δθ_k + δθ_{k+1})
+  //   δΩ_i = D^i·(δθ_{k+1} − δθ_k)/Δs
+  // (a common rotation leaves Γ unchanged; the half-point triad turns by the mean of its two
+  // ends'). K = Δs Σ_h J_hᵀ C J_h, C = diag(b1, b2, b3, a1, a2, a3): symmetric positive
+  // semi-definite, O(n), block-cyclic-tridiagonal: Kd_[k] = K[k][k], Ko_[k] = K[k+1][k].
+  // tests/unit/integrate/test_implicit_parts.cpp compares it with the finite-difference K.
+  const int n = s.size();
+  const rod::RodParams& rp = st_.params().rod;
+  using Mat6 = Eigen::Matrix<double, 6, 6>;
+  Kd_.assign(n, Mat6::Zero());
+  Ko_.assign(n, Mat6::Zero());
+  Eigen::Matrix<double, 6, 1> c;
+  c << rp.b.x(), rp.b.y(), rp.b.z(), rp.a.x(), rp.a.y(), rp.a.z();
+  for (int h = 0; h < n; ++h) {
+    const int h1 = (h + 1) % n;
+    const Mat3 Dh = rod::half_point_triad(s.D[h], s.D[h1]);
+    const Vec3 xp = (s.X[h1] - s.X[h]) / rp.ds;
+    Mat3 G;  // rows (D^i × X′)ᵀ
+    for (int i = 0; i < 3; ++i) G.row(i) = Dh.col(i).cross(xp).transpose();
+    Mat6 JL = Mat6::Zero(), JR = Mat6::Zero();  // ∂(Γ, Ω)/∂q_h, ∂(Γ, Ω)/∂q_{h+1}
+    JL.block<3, 3>(0, 0) = -Dh.transpose() / rp.ds;
+    JR.block<3, 3>(0, 0) = Dh.transpose() / rp.ds;
+    JL.block<3, 3>(0, 3) = 0.5 * G;
+    JR.block<3, 3>(0, 3) = 0.5 * G;
+    JL.block<3, 3>(3, 3) = -Dh.transpose() / rp.ds;
+    JR.block<3, 3>(3, 3) = Dh.transpose() / rp.ds;
+    const Mat6 CL = rp.ds * c.asDiagonal() * JL, CR = rp.ds * c.asDiagonal() * JR;
+    Kd_[h].noalias() += JL.transpose() * CL;
+    Kd_[h1].noalias() += JR.transpose() * CR;
+    Ko_[h].noalias() = JR.transpose() * CL;  // K[h+1][h]
+  }
+}
+
 Eigen::SparseMatrix<double> ImplicitStepper::stiffness(const rod::RodState& s) {
   const int n = s.size();
   const rod::RodParams& rp = st_.params().rod;
   if (p_.gauss_newton && !p_.stiffness_fd) {
-    // Gauss–Newton with the small-strain strain Jacobian of half point h (between k and k+1,
-    // triad D_h = [D¹ D² D³], X′ = (X_{k+1} − X_k)/Δs), MODEL §4 step 2 linearised:
-    //   δΓ_i = D^i·(δX_{k+1} − δX_k)/Δs + ½ (D^i × X′)·(δθ_k + δθ_{k+1})
-    //   δΩ_i = D^i·(δθ_{k+1} − δθ_k)/Δs
-    // (a common rotation leaves Γ unchanged; the half-point triad turns by the mean of its two
-    // ends'). K = Δs Σ_h J_hᵀ C J_h, C = diag(b1, b2, b3, a1, a2, a3): symmetric positive
-    // semi-definite, O(n). tests/integration/test_implicit.cpp compares it with the
-    // finite-difference Gauss–Newton K.
+    gn_blocks(s);
     std::vector<Eigen::Triplet<double>> trip;
-    trip.reserve(std::size_t(n) * 4 * 36 + 4096);
-    using Mat6 = Eigen::Matrix<double, 6, 6>;
-    Eigen::Matrix<double, 6, 1> c;
-    c << rp.b.x(), rp.b.y(), rp.b.z(), rp.a.x(), rp.a.y(), rp.a.z();
+    trip.reserve(std::size_t(n) * 3 * 36 + 4096);
     for (int h = 0; h < n; ++h) {
       const int h1 = (h + 1) % n;
-      const Mat3 Dh = rod::half_point_triad(s.D[h], s.D[h1]);
-      const Vec3 xp = (s.X[h1] - s.X[h]) / rp.ds;
-      Mat3 G;  // rows (D^i × X′)ᵀ
-      for (int i = 0; i < 3; ++i) G.row(i) = Dh.col(i).cross(xp).transpose();
-      Mat6 JL = Mat6::Zero(), JR = Mat6::Zero();  // ∂(Γ, Ω)/∂q_h, ∂(Γ, Ω)/∂q_{h+1}
-      JL.block<3, 3>(0, 0) = -Dh.transpose() / rp.ds;
-      JR.block<3, 3>(0, 0) = Dh.transpose() / rp.ds;
-      JL.block<3, 3>(0, 3) = 0.5 * G;
-      JR.block<3, 3>(0, 3) = 0.5 * G;
-      JL.block<3, 3>(3, 3) = -Dh.transpose() / rp.ds;
-      JR.block<3, 3>(3, 3) = Dh.transpose() / rp.ds;
-      const int idx[2] = {h, h1};
-      const Mat6* J[2] = {&JL, &JR};
-      for (int a = 0; a < 2; ++a)
-        for (int b = 0; b < 2; ++b) {
-          const Mat6 blk = rp.ds * J[a]->transpose() * c.asDiagonal() * (*J[b]);
-          for (int r = 0; r < 6; ++r)
-            for (int q = 0; q < 6; ++q)
-              trip.emplace_back(6 * idx[a] + r, 6 * idx[b] + q, blk(r, q));
+      for (int r = 0; r < 6; ++r)
+        for (int q = 0; q < 6; ++q) {
+          trip.emplace_back(6 * h + r, 6 * h + q, Kd_[h](r, q));
+          trip.emplace_back(6 * h1 + r, 6 * h + q, Ko_[h](r, q));
+          trip.emplace_back(6 * h + r, 6 * h1 + q, Ko_[h](q, r));
         }
     }
-    contacts_ = p_.steric_implicit ? add_steric_stiffness(st_.params().steric, s.X, trip) : 0;
+    contacts_ = p_.steric_implicit ? add_steric_stiffness(st_.params().steric, s.X, &trip) : 0;
     Eigen::SparseMatrix<double> K(6 * n, 6 * n);
     K.setFromTriplets(trip.begin(), trip.end());
     K.makeCompressed();
@@ -254,7 +292,7 @@ Eigen::SparseMatrix<double> ImplicitStepper::stiffness(const rod::RodState& s) {
         }
     }
   }
-  contacts_ = p_.steric_implicit ? add_steric_stiffness(st_.params().steric, s.X, trip) : 0;
+  contacts_ = p_.steric_implicit ? add_steric_stiffness(st_.params().steric, s.X, &trip) : 0;
   Eigen::SparseMatrix<double> K(6 * n, 6 * n);
   K.setFromTriplets(trip.begin(), trip.end());
   K.makeCompressed();
@@ -267,6 +305,21 @@ void ImplicitStepper::factorize(double dt) {
   for (int k = 0; k < n_; ++k) {
     mloc_.segment<3>(6 * k).setConstant(p_.mobility_scale * m_t_);
     mloc_.segment<3>(6 * k + 3).setConstant(p_.mobility_scale * m_r_);
+  }
+  if (use_blocks_) {
+    std::vector<Eigen::Matrix<double, 6, 6>>& diag = sdiag_;
+    std::vector<Eigen::Matrix<double, 6, 6>>& lower = slower_;
+    diag.resize(n_);
+    lower.resize(n_);
+    for (int k = 0; k < n_; ++k) {
+      diag[k] = dt * Kd_[k];
+      for (int i = 0; i < 6; ++i) diag[k](i, i) += 1.0 / mloc_[6 * k + i];
+      lower[k] = dt * Ko_[k];
+    }
+    if (!bcc_.factorize(diag, lower))
+      throw std::runtime_error("ImplicitStepper: the local implicit system is not positive");
+    lu_dt_ = dt;
+    return;
   }
   const bool contacts_changed = contacts_ > 0 || pattern_contacts_ > 0;
   if (p_.gauss_newton) {
@@ -308,6 +361,11 @@ void ImplicitStepper::factorize(double dt) {
 }
 
 Eigen::VectorXd ImplicitStepper::local_solve(const Eigen::VectorXd& v) const {
+  if (use_blocks_) {
+    VectorXd x = p_.velocity_form ? VectorXd(v.cwiseQuotient(mloc_)) : v;
+    bcc_.solve(x);
+    return p_.velocity_form ? x : VectorXd(x.cwiseQuotient(mloc_));
+  }
   if (!p_.gauss_newton) return lu_.solve(v);
   // velocity form: (I + Δt M_loc K) x = v ⇔ S x = M_loc⁻¹ v;
   // force form: (I + Δt K M_loc) x = v ⇔ S (M_loc x) = v
@@ -409,9 +467,20 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
   pack(c0.F, c0.T, b);
 
   if (local || p_.krylov_max_iter > 0) {
-    if (steps_since_jacobian_ == 0 || K_.rows() != 6 * n) {
+    if (steps_since_jacobian_ == 0 || !have_K_) {
       const double t0 = now();
-      K_ = stiffness(s);
+      // the fast path: no contacts, the local system is block-cyclic-tridiagonal
+      use_blocks_ = false;
+      if (p_.block_solver && local && p_.gauss_newton && !p_.stiffness_fd &&
+          p_.krylov_max_iter == 0 && n >= 3 &&
+          (!p_.steric_implicit || add_steric_stiffness(st_.params().steric, s.X, nullptr) == 0)) {
+        gn_blocks(s);
+        contacts_ = 0;
+        use_blocks_ = true;
+      } else {
+        K_ = stiffness(s);
+      }
+      have_K_ = true;
       timings_.stiffness += now() - t0;
       info.jacobian_refreshed = true;
       lu_dt_ = -1;

@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "integrate/adaptive_dt.hpp"
+#include "integrate/block_cyclic.hpp"
 #include "integrate/stepper.hpp"
 
 namespace ibrod::integrate {
@@ -48,6 +49,9 @@ struct ImplicitParams {
   bool gauss_newton = true;      ///< K = Δs Σ Jᵀ C J (positive semi-definite) instead of −∂F/∂q
   bool stiffness_fd = false;     ///< Gauss–Newton K by finite differences (else small-strain
                                  ///< analytic strain Jacobian, O(n))
+  /// without contacts, solve the local system with BlockCyclicCholesky (else the general sparse
+  /// Cholesky; the same solution to round-off)
+  bool block_solver = true;
   bool steric_implicit = true;   ///< add the steric contacts' stiffness to K
   double fd_dx = 1e-4;           ///< finite-difference step of K in positions, Å
   double fd_dtheta = 1e-5;       ///< ... and in rotation vectors, rad
@@ -124,6 +128,11 @@ class ImplicitStepper {
   Eigen::SparseLU<Eigen::SparseMatrix<double>> lu_;             // full K (not symmetric)
   Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> llt_;        // Gauss–Newton K
   Eigen::VectorXd mloc_;                                         // diagonal of M_loc
+  std::vector<Eigen::Matrix<double, 6, 6>> Kd_, Ko_;  // GN K blocks: K[k][k], K[k+1][k]
+  BlockCyclicCholesky bcc_;                          // their local system, no contacts
+  std::vector<Eigen::Matrix<double, 6, 6>> sdiag_, slower_;  // its blocks (scratch)
+  bool use_blocks_ = false, have_K_ = false;
+  void gn_blocks(const rod::RodState& s);            // fills Kd_, Ko_
   Eigen::VectorXd local_solve(const Eigen::VectorXd& v) const;   // (I + Δt M_loc K)⁻¹ v
   bool pattern_ready_ = false;
   Eigen::Index pattern_nnz_ = 0;
