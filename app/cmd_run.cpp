@@ -12,6 +12,7 @@
 #include "config/config.hpp"
 #include "core/error.hpp"
 #include "driver/bench.hpp"
+#include "driver/bench_schemes.hpp"
 #include "driver/mpi_env.hpp"
 #include "driver/run.hpp"
 #include "exit_status.hpp"
@@ -35,6 +36,8 @@ struct RunArgs : ConfigArgs {
 
 struct BenchArgs : ConfigArgs {
   int steps = 200, threads = 0;
+  bool schemes = false;          // issue 14: explicit against implicit, µs per wall hour
+  double implicit_dt_ns = 2, implicit_ns = 200;
 };
 
 cfg::Config resolve(const ConfigArgs& a) {
@@ -123,6 +126,11 @@ int bench_main(const BenchArgs& a) {
     cfg::Config c = resolve(a);
     if (a.threads > 0) c.run_threads = a.threads;
     cfg::check_memory(c);
+    if (a.schemes) {
+      driver::print_bench_schemes(
+          driver::bench_schemes(c, a.steps, a.implicit_dt_ns, a.implicit_ns), stdout);
+      return 0;
+    }
     driver::print_bench(c, driver::bench(c, a.steps), stdout);
     return 0;
   } catch (const std::exception& e) {
@@ -168,5 +176,15 @@ void add_run_commands(CLI::App& app) {
       ->capture_default_str();
   bench->add_option("--threads", ba->threads, "threads (0: run.threads of the config)")
       ->check(CLI::NonNegativeNumber);
+  bench->add_flag("--schemes", ba->schemes,
+                  "instead: simulated µs per wall hour of the explicit scheme (--steps steps of "
+                  "time.dt_ns) and the implicit one (--implicit-ns at Δt ≤ --implicit-dt-ns); "
+                  "last line us_per_hour_explicit=… us_per_hour_implicit=…");
+  bench->add_option("--implicit-dt-ns", ba->implicit_dt_ns, "with --schemes: the implicit Δt max")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  bench->add_option("--implicit-ns", ba->implicit_ns, "with --schemes: implicit simulated ns")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   bench->callback([ba] { throw CLI::RuntimeError(bench_main(*ba)); });
 }

@@ -37,6 +37,14 @@ struct Config {
   double time_stability_probe_us = 0.5;        ///< how long the perturbed copy is integrated, µs
   double time_stability_tolerance_kT = 1e-3;   ///< an energy drop beyond this: unstable, kT
   std::int64_t time_stability_seed = 1;        ///< seed of the test's perturbation
+  std::string time_scheme = "explicit";  ///< time.scheme: "explicit" | "implicit" (issue 14)
+  double time_max_displacement_A = 0;    ///< implicit: largest point move per step, Å (0: auto)
+  double time_energy_tolerance_kT = 1e-6;  ///< implicit: allowed energy rise per step, kT
+  double time_dt_min_ns = 0;             ///< implicit: smallest step, ns (0: time.dt_ns / 1000)
+  double time_implicit_mobility_scale = 8;   ///< implicit: β of M_loc
+  int time_implicit_jacobian_every = 1;      ///< implicit: steps between stiffness refreshes
+  int time_implicit_krylov_iterations = 0;   ///< implicit: GMRES iterations (0: IMEX)
+  double time_implicit_krylov_tol = 1e-2;    ///< implicit: GMRES relative residual
   // [rod]
   int rod_base_pairs = 600;        ///< rod.base_pairs: rod points n
   int rod_excess_link = 6;         ///< rod.excess_link: ΔLk (integer)

@@ -43,6 +43,9 @@ void validate(const Config& c) {
         "at most " + fmt(kMaxBoxPerRise) + " rod.rise_A = " +
             fmt(kMaxBoxPerRise * c.rod_rise_A) +
             " Å (positions of that size keep 6 digits of a segment in double precision)");
+  if (c.time_scheme == "implicit" && c.time_dt_min_ns > c.time_dt_ns)
+    bad("time.dt_min_ns", fmt(c.time_dt_min_ns),
+        "at most time.dt_ns = " + fmt(c.time_dt_ns) + " ns (the implicit scheme's largest step)");
   if (c.time_dt_ns * 1e-3 > c.time_t_end_us)
     bad("time.t_end_us", fmt(c.time_t_end_us),
         "at least one time step (time.dt_ns = " + fmt(c.time_dt_ns) + " ns)");
@@ -128,6 +131,17 @@ sim::SimParams to_params(const Config& c) {
   p.output.rows = c.output_every_steps;
   p.output.frames = frame_every(c);
   p.output.checkpoints = c.output_checkpoint_every_steps;
+  // issue 14: the implicit scheme (docs/large_dt.md); its dt_max is p.dt, its automatic
+  // max_displacement and dt_min are resolved by sim::Simulation
+  p.scheme = c.time_scheme == "implicit" ? sim::TimeScheme::implicit_step
+                                         : sim::TimeScheme::explicit_step;
+  p.adaptive.max_displacement = c.time_max_displacement_A * angstrom;
+  p.adaptive.energy_tolerance = c.time_energy_tolerance_kT * p.kT;
+  p.adaptive.dt_min = c.time_dt_min_ns * ns;
+  p.implicit.mobility_scale = c.time_implicit_mobility_scale;
+  p.implicit.jacobian_every = c.time_implicit_jacobian_every;
+  p.implicit.krylov_max_iter = c.time_implicit_krylov_iterations;
+  p.implicit.krylov_tol = c.time_implicit_krylov_tol;
   return p;
 }
 

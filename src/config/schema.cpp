@@ -169,6 +169,23 @@ Key frame_key() {
   return k;
 }
 
+// time.scheme: one of a few words (a string key)
+Key scheme_key() {
+  Key k;
+  k.name = "time.scheme";
+  k.help = "time scheme: \"explicit\" (MODEL §4, the reference) or \"implicit\" (Stokes limit, "
+           "implicit stiffness, adaptive Δt ≤ time.dt_ns; docs/large_dt.md)";
+  k.set = [](Config& c, const toml::node& n) {
+    const auto v = n.value_exact<std::string>();
+    if (!v || (*v != "explicit" && *v != "implicit"))
+      bad("time.scheme", show(n), "\"explicit\" or \"implicit\"");
+    c.time_scheme = *v;
+  };
+  k.put = [](const Config& c, toml::table& t) { t.insert_or_assign("scheme", c.time_scheme); };
+  k.value = [](const Config& c) { return "\"" + c.time_scheme + "\""; };
+  return k;
+}
+
 // rod.perturbation_random = { modes = M, amplitude = A, seed = S }: an inline table (a Key whose
 // value is a table). A partial table changes only the sub-keys it names, so that `--set
 // rod.perturbation_random.seed=7` (see set_key) works on top of a file's table. Written back as the
@@ -255,6 +272,25 @@ const std::vector<Key>& schema() {
       integer("time.stability_seed", &Config::time_stability_seed, 0,
               std::numeric_limits<std::int64_t>::max(),
               "seed of the stability test's perturbation"),
+      scheme_key(),
+      real("time.max_displacement_A", &Config::time_max_displacement_A, 0, false, inf,
+           "implicit: largest move of a rod point in one step, Å; a longer step is retried "
+           "shorter (0: 0.2 min(Debye length, steric.diameter_A))"),
+      real("time.energy_tolerance_kT", &Config::time_energy_tolerance_kT, 0, false, inf,
+           "implicit: largest rise of the potential energy in one step, kT; a step that raises "
+           "it more is retried shorter"),
+      real("time.dt_min_ns", &Config::time_dt_min_ns, 0, false, inf,
+           "implicit: smallest step, ns, always accepted (0: time.dt_ns/1000)"),
+      real("time.implicit_mobility_scale", &Config::time_implicit_mobility_scale, 0, true, 1e6,
+           "implicit: local mobility M_loc = this × the kernel's self mobility"),
+      integer("time.implicit_jacobian_every", &Config::time_implicit_jacobian_every, 1, 1000000,
+              "implicit: steps between refreshes of the stiffness and its factorisation (> 1: "
+              "faster; a run resumed after a signal is then not bitwise the same)"),
+      integer("time.implicit_krylov_iterations", &Config::time_implicit_krylov_iterations, 0,
+              1000, "implicit: GMRES iterations toward linearly implicit Euler (0: none, IMEX)"),
+      real("time.implicit_krylov_tol", &Config::time_implicit_krylov_tol, 0, true, 1,
+           "implicit: relative residual at which GMRES stops (not reached: the step is retried "
+           "shorter)"),
       integer("rod.base_pairs", &Config::rod_base_pairs, 8, 1000000,
               "rod points = base pairs n"),
       integer("rod.excess_link", &Config::rod_excess_link, -1000, 1000,

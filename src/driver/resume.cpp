@@ -107,6 +107,8 @@ void Run::State::restore_state() {
     // checkpoints from before time was state: step × Δt of the run that wrote them
     const double time = meta.time_s >= 0 ? meta.time_s : double(meta.step) * sim->dt();
     sim->restore_clock(meta.step, time);
+    if (meta.implicit_next_dt_s > 0)
+      sim->restore_implicit_state({meta.implicit_next_dt_s, meta.implicit_accepted_in_a_row});
     result.initial = meta.initial;
     result.resumed_from = result.checkpoint_step = meta.step;
     checkpoint.reset();  // the state lives in sim now; free the copy

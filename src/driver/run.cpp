@@ -159,6 +159,12 @@ void Run::State::write_frame() {
 void Run::State::write_checkpoint(StopReason reason) {
   meta.step = sim->step_count();
   meta.time_s = sim->time();
+  if (sim->implicit()) {
+    const auto st = sim->implicit_state();
+    meta.implicit_next_dt_s = st.next_dt;
+    meta.implicit_accepted_in_a_row = st.accepted_in_a_row;
+    sim->checkpoint_taken();  // the resumed run starts the same way (bitwise resume)
+  }
   meta.stop_reason = to_string(reason);
   meta.wall_s = wall_before + seconds_since(t0);
   const auto u = sim->stepper().whole_velocity(gathered);

@@ -400,3 +400,86 @@ double FluidSolver::max_divergence() const {
 }
 
 }  // namespace ibrod::fluid
+
+// ---------------------------------------------------------------------------------------------
+// Stokes limit (issue 14): the implicit rod–fluid scheme applies the IB mobility
+// M = interpolate ∘ (−μL_h)⁻¹P ∘ spread once per Krylov iteration, with ρ/Δt dropped.
+namespace ibrod::fluid {
+namespace {
+
+// One x-row of û = P f̂ / (−μL̂) / n³ (cf. solve_row): lap = −L̂ ≥ 0, zero only at k = 0, whose
+// entries the caller overwrites. kEps keeps the quotient finite there and where ĝ = 0 without a
+// branch (DBL_MIN would underflow in the product), and leaves every nonzero |ĝ|², −L̂
+// (≥ ~1e-6 Å⁻²) bit-for-bit unchanged.
+IBROD_TARGET_CLONES void solve_row_stokes(int len, double gx, double gy, double gxy2, double lxy,
+                                          const double* gz2, const double* lz2, double out_scale,
+                                          double* r0, double* r1, double* r2) {
+#pragma omp simd
+  for (int t = 0; t < len; ++t) {
+    const double gz = gz2[t];
+    constexpr double kEps = 1e-150;
+    const double g2 = gxy2 + gz * gz + kEps;      // |ĝ|² + ε, Å⁻²
+    const double lap = lxy + lz2[t] + kEps;       // −L̂ + ε, Å⁻²
+    const double q = 1.0 / (g2 * lap);
+    const double ig2 = lap * q;                   // 1/|ĝ|²
+    const double scale = out_scale * (g2 * q);    // 1/(n³ μ (−L̂))
+    const double a0 = r0[t], a1 = r1[t], a2 = r2[t];
+    const double p = (gx * a0 + gy * a1 + gz * a2) * ig2;
+    r0[t] = scale * (a0 - gx * p);
+    r1[t] = scale * (a1 - gy * p);
+    r2[t] = scale * (a2 - gz * p);
+  }
+}
+
+}  // namespace
+
+void FluidSolver::solve_slice_stokes(int j) {
+  const int n = grid_.n;
+  const double out_scale = 1.0 / double(grid_.size()) / params_.viscosity;
+  const int nzh = n / 2 + 1;
+  const double* gs = grad_symbol_.data();
+  const double* ls = lap_symbol_.data();
+  double* r0 = reinterpret_cast<double*>(fh_[0]);
+  double* r1 = reinterpret_cast<double*>(fh_[1]);
+  double* r2 = reinterpret_cast<double*>(fh_[2]);
+  const double gy = gs[j];
+  for (int i = 0; i < n; ++i) {
+    const double gx = gs[i];
+    const std::size_t o = 2 * (std::size_t(i) * plane_c_ + std::size_t(j) * nzh);
+    solve_row_stokes(2 * nzh, gx, gy, gx * gx + gy * gy, ls[i] + ls[j], grad_symbol2_.data(),
+                     lap_symbol2_.data(), out_scale, r0 + o, r1 + o, r2 + o);
+    if (i == 0 && j == 0)  // the mean: a net force has no periodic Stokes solution; u's mean = 0
+      for (double* r : {r0, r1, r2}) r[o] = r[o + 1] = 0.0;
+  }
+}
+
+void FluidSolver::solve_stokes(const PlaneForcing& forcing, const PlaneSampler* sampler) {
+  if (!(params_.viscosity > 0.0))
+    throw std::logic_error("FluidSolver::solve_stokes: needs a viscosity > 0");
+  if (!force_zero_)
+    throw std::logic_error("FluidSolver::solve_stokes: force() must be zero (it was written)");
+  const int n = grid_.n;
+  const int nzh = n / 2 + 1;
+  const std::size_t np = std::size_t(n) * n;
+  fftw_plan plan = as_plan(plan_plane_r2c_);
+  fftw_complex* base = reinterpret_cast<fftw_complex*>(fh_[0]);
+#pragma omp parallel for num_threads(threads_) schedule(static)
+  for (int i = 0; i < n; ++i) {
+    double* buf = plane_buf_ + 3 * comp_p_ * std::size_t(omp_get_thread_num());
+    const std::array<double*, 3> r{buf, buf + comp_p_, buf + 2 * comp_p_};
+    for (int c = 0; c < 3; ++c) std::fill_n(r[c], np, 0.0);
+    forcing.add_plane(i, r);
+    fftw_execute_dft_r2c(plan, buf, base + i * plane_c_);
+  }
+#pragma omp parallel for num_threads(threads_) schedule(static)
+  for (int j = 0; j < n; ++j) {
+    const int par = (j * nzh) % 2;
+    fftw_complex* slice = base + std::size_t(j) * nzh;
+    fftw_execute_dft(as_plan(plan_x_fwd_[par]), slice, slice);
+    solve_slice_stokes(j);
+    fftw_execute_dft(as_plan(plan_x_bwd_[par]), slice, slice);
+  }
+  pass_inverse_planes(sampler);
+}
+
+}  // namespace ibrod::fluid

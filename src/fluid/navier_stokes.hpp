@@ -104,6 +104,14 @@ class FluidSolver {
   void pass_pencils();
   void pass_inverse_planes(const PlaneSampler* sampler = nullptr);
 
+  /// Stokes limit (issue 14, the implicit scheme's mobility): overwrites velocity() with the
+  /// zero-mean solution of 0 = −G_h p + μ L_h u + f, D_h·u = 0, f the force density of
+  /// `forcing` alone (ρ, Δt, advection and the previous velocity play no part):
+  ///   û = P(k) f̂ / (−μ L̂(k)) for k ≠ 0,  û(0) = 0.
+  /// force() must be zero (it is after every step). The same fused plane and slice passes as
+  /// step(), with `sampler` (if given) reading each plane of u as it is made. No allocation.
+  void solve_stokes(const PlaneForcing& forcing, const PlaneSampler* sampler = nullptr);
+
   /// Fluid kinetic energy ½ρ Σ|u|² h³, g Å² s⁻².
   double kinetic_energy() const;
   /// max over the grid of |D_h·u| (central-difference divergence), s⁻¹.
@@ -148,6 +156,7 @@ class FluidSolver {
   void release_plans();
   void solve_slice(int j);           // r̂ → ûⁿ⁺¹ in place on the y-slice j: projection,
                                      // implicit viscosity, 1/n³
+  void solve_slice_stokes(int j);    // f̂ → û of the Stokes limit in place on the y-slice j
 };
 
 }  // namespace ibrod::fluid

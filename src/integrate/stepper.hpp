@@ -110,6 +110,11 @@ class Stepper {
   ib::PlaneCoupler& plane_coupler() { return plane_coupler_; }
   interactions::Electrostatics& electrostatics() { return electro_; }
   interactions::Steric& steric() { return steric_; }
+  /// [n] point forces (g Å s⁻²) and torques (g Å² s⁻²) of the latest compute_forces() or step();
+  /// velocities U (Å s⁻¹) of the latest step() (the implicit scheme, issue 14, reads them)
+  const std::vector<Vec3>& forces() const { return F_; }
+  const std::vector<Vec3>& torques() const { return T_; }
+  const std::vector<Vec3>& velocities() const { return U_; }
 
  private:
   StepperParams p_;

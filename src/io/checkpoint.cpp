@@ -66,6 +66,8 @@ std::string meta_json(const CheckpointMeta& m) {
   j["wall_s"] = m.wall_s;
   j["resumes"] = m.resumes;
   j["stability_tests"] = nlohmann::json::parse(m.stability_tests_json);
+  j["implicit_next_dt_s"] = m.implicit_next_dt_s;
+  j["implicit_accepted_in_a_row"] = m.implicit_accepted_in_a_row;
   j["initial"] = observables_json(m.initial);
   j["config_toml"] = m.config_toml;
   return j.dump();  // doubles with 17 significant digits: they read back exactly
@@ -85,6 +87,11 @@ CheckpointMeta meta_from(const std::string& text) {
   m.wall_s = j.at("wall_s").get<double>();
   m.resumes = j.at("resumes").get<std::int64_t>();
   m.stability_tests_json = j.contains("stability_tests") ? j.at("stability_tests").dump() : "[]";
+  // absent in checkpoints from before the implicit scheme
+  if (j.contains("implicit_next_dt_s")) {
+    m.implicit_next_dt_s = j.at("implicit_next_dt_s").get<double>();
+    m.implicit_accepted_in_a_row = j.at("implicit_accepted_in_a_row").get<int>();
+  }
   m.initial = observables_from(j.at("initial"));
   m.config_toml = j.at("config_toml").get<std::string>();
   return m;

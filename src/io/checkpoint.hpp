@@ -44,6 +44,10 @@ struct CheckpointMeta {
   /// the stability tests so far (sim/stability.hpp), a JSON array of objects as summary.json
   /// lists them
   std::string stability_tests_json = "[]";
+  /// time.scheme = "implicit": the step controller's next Δt (s; −1 if absent) and its run of
+  /// accepted steps (sim::Simulation::implicit_state)
+  double implicit_next_dt_s = -1;
+  int implicit_accepted_in_a_row = 0;
 };
 
 struct Checkpoint {

@@ -27,6 +27,10 @@ StopReason stop_reason_from(const std::string& name) {
   return StopReason::error;
 }
 
+std::string to_string(TimeScheme s) {
+  return s == TimeScheme::implicit_step ? "implicit" : "explicit";
+}
+
 std::int64_t steps_to_reach(double t_end, double dt) {
   return std::int64_t(std::ceil(t_end / dt - 0.5));
 }
@@ -39,6 +43,23 @@ SimParams checked(SimParams p) {
     throw std::invalid_argument("Simulation: output intervals must be positive (frames, "
                                 "checkpoints: or 0)");
   p.stepper.fluid.dt = p.dt;  // the fluid's Δt is the simulation's
+  if (p.scheme == TimeScheme::implicit_step) {
+    if (p.stepper.distributed)
+      throw std::invalid_argument("Simulation: the implicit scheme runs on one process only");
+    integrate::AdaptiveDtParams& a = p.adaptive;
+    a.dt_max = p.dt;
+    if (!(a.dt_min > 0)) a.dt_min = 1e-3 * p.dt;
+    a.dt_min = std::min(a.dt_min, p.dt);
+    if (!(a.max_displacement > 0)) {
+      // the pair forces stay explicit: a step moves no point by more than a fifth of the
+      // shorter of their ranges (Debye length, hard-core diameter)
+      double range = p.stepper.rod.ds * 10;
+      if (p.stepper.electro.enabled && p.stepper.electro.law.kappa > 0)
+        range = 1 / p.stepper.electro.law.kappa;
+      if (p.stepper.steric.enabled) range = std::min(range, p.stepper.steric.diameter);
+      a.max_displacement = 0.2 * range;
+    }
+  }
   return p;
 }
 }  // namespace
@@ -50,9 +71,17 @@ Simulation::Simulation(const SimParams& p)
   // MODEL §6: the electrostatic energy is also reported relative to the circle at the same salt.
   // The unperturbed circle (perturbation only rotates triads, so X is the same).
   if (p_.stepper.electro.enabled) electro_circle_ = stepper_.electrostatics().energy(rod_.X);
+  if (p_.scheme == TimeScheme::implicit_step)
+    implicit_ = std::make_unique<integrate::ImplicitIntegrator>(stepper_, p_.implicit, p_.adaptive);
 }
 
 void Simulation::step() {
+  if (implicit_) {
+    // the last step lands on t_end
+    time_ += implicit_->advance(rod_, std::max(p_.t_end - time_, p_.adaptive.dt_min));
+    ++step_;
+    return;
+  }
   stepper_.step(rod_);
   ++step_;
   time_ += p_.dt;

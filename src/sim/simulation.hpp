@@ -7,8 +7,10 @@
 // checkpoint_due() and stop_reason(), and writes.
 #include <algorithm>
 #include <cstdint>
+#include <memory>
 #include <string>
 
+#include "integrate/implicit.hpp"
 #include "integrate/stepper.hpp"
 #include "sim/stability.hpp"
 #include "rod/rod.hpp"
@@ -24,11 +26,21 @@ struct OutputSchedule {
   std::int64_t checkpoints = 10000;
 };
 
+/// The time scheme (`time.scheme`): MODEL §4's explicit step (the reference), or the implicit
+/// Stokes-limit step with an adaptive Δt (issue 14, docs/large_dt.md).
+enum class TimeScheme { explicit_step, implicit_step };
+std::string to_string(TimeScheme s);  ///< "explicit", "implicit"
+
 /// Everything a trajectory needs, in internal units (g, Å, s).
 struct SimParams {
   integrate::StepperParams stepper;  ///< its fluid.dt is set from dt by Simulation
   rod::CircleParams circle;
-  double dt = 1e-10;            ///< time step Δt, s
+  TimeScheme scheme = TimeScheme::explicit_step;
+  /// implicit only: the scheme's knobs, and the controller's (its dt_max is set from dt; a
+  /// dt_min ≤ 0 becomes 1e-3 dt, a max_displacement ≤ 0 becomes 0.2 min(1/κ, D))
+  integrate::ImplicitParams implicit;
+  integrate::AdaptiveDtParams adaptive;
+  double dt = 1e-10;            ///< time step Δt, s (implicit: the largest and the first)
   double t_end = 1e-6;          ///< s
   double stop_kinetic = 0;      ///< stop when E_K < this (g Å² s⁻²) at an output step; 0: never
   StabilityProbe stability;     ///< tests a state the kinetic-energy rule calls an equilibrium
@@ -72,7 +84,25 @@ class Simulation {
   const integrate::Stepper& stepper() const { return stepper_; }
   std::int64_t step_count() const { return step_; }
   double time() const { return time_; }   ///< simulated time, s
-  double dt() const { return p_.dt; }     ///< time step, s
+  double dt() const { return p_.dt; }     ///< time step, s (implicit: the largest)
+  /// The Δt the next step will try (explicit: dt(); implicit: the controller's), s.
+  double next_dt() const { return implicit_ ? implicit_->state().next_dt : p_.dt; }
+  /// The implicit scheme (nullptr for the explicit one).
+  integrate::ImplicitIntegrator* implicit() { return implicit_.get(); }
+  const integrate::ImplicitIntegrator* implicit() const { return implicit_.get(); }
+  /// Implicit: what a checkpoint must keep besides rod and clock (the controller's next Δt and
+  /// run of accepted steps), and putting it back. checkpoint_taken() is to be called where a
+  /// checkpoint is written, so that the run and its resumption refresh the scheme's stiffness
+  /// at the same step (resume stays bitwise). No-ops for the explicit scheme.
+  integrate::ImplicitIntegrator::State implicit_state() const {
+    return implicit_ ? implicit_->state() : integrate::ImplicitIntegrator::State{p_.dt, 0};
+  }
+  void restore_implicit_state(const integrate::ImplicitIntegrator::State& st) {
+    if (implicit_) implicit_->restore(st);
+  }
+  void checkpoint_taken() {
+    if (implicit_) implicit_->refresh();
+  }
   /// Sets the step counter and the simulated time when a checkpoint restores rod() and the fluid
   /// velocity; nothing else of the state depends on them.
   void restore_clock(std::int64_t step, double time) {
@@ -80,14 +110,21 @@ class Simulation {
     time_ = time;
   }
 
-  /// One time step: the state and the time advance by Δt.
+  /// One time step: the state and the time advance by Δt (implicit: by the accepted step,
+  /// never past t_end).
   void step();
 
   /// Whether the simulated time has reached t_end, with half a step of tolerance (the
-  /// end-of-run rule: t_end = k Δt stops after exactly k steps; steps_to_reach).
-  bool at_end() const { return time_ >= p_.t_end - 0.5 * p_.dt; }
+  /// end-of-run rule: t_end = k Δt stops after exactly k steps; steps_to_reach). Implicit: the
+  /// last step lands on t_end (to round-off).
+  bool at_end() const {
+    return implicit_ ? time_ >= p_.t_end * (1 - 1e-12) : time_ >= p_.t_end - 0.5 * p_.dt;
+  }
   /// The step at which at_end() becomes true at the present Δt (progress lines, estimates).
-  std::int64_t end_step() const { return step_ + std::max<std::int64_t>(0, steps_to_reach(p_.t_end - time_, p_.dt)); }
+  std::int64_t end_step() const {
+    if (at_end()) return step_;
+    return step_ + std::max<std::int64_t>(1, steps_to_reach(p_.t_end - time_, next_dt()));
+  }
   /// Whether the current step is an output step: a time-series row is due (every
   /// output.rows steps, and at the end).
   bool output_due() const { return step_ % p_.output.rows == 0 || at_end(); }
@@ -111,6 +148,7 @@ class Simulation {
   SimParams p_;
   rod::RodState rod_;
   integrate::Stepper stepper_;
+  std::unique_ptr<integrate::ImplicitIntegrator> implicit_;  // time.scheme = "implicit"
   std::int64_t step_ = 0;
   double time_ = 0;               ///< s
   double electro_circle_ = 0;  ///< E_electro of the initial circle, g Å² s⁻²

@@ -1,0 +1,201 @@
+#pragma once
+// Implicit rod–fluid coupling with a large time step (issue 14, docs/large_dt.md).
+//
+// In the Stokes limit (ρh²/(μΔt) ≈ 0.01 at Δt = 0.1 ns and smaller for larger steps) the fluid is
+// a linear map from the rod's point forces and torques g = (F_k, T_k) to its velocities and
+// angular velocities (U_k, W_k):
+//   M g = interpolate ∘ (−μL_h)⁻¹ P ∘ spread g        (one Stokes solve, FluidSolver::solve_stokes)
+// and the rod is overdamped: q̇ = M g(q), q = (X_k, θ_k) (positions, lab-frame rotation vectors
+// of the triads). Forward Euler in this form is the explicit scheme; its Δt is bounded by the
+// stretch/shear/bend/twist stiffness at the kernel scale. The implicit force of the linearly
+// implicit Euler step is
+//   g = F(qⁿ) + H δ,  δ = Δt M g  ⇒  (I + Δt K M) g = F(qⁿ),   K = −H = −∂F/∂q   (1)
+// (F = elastic + electrostatic + steric; K = elastic stiffness only: the pair forces stay
+// explicit). This class solves (1) by GMRES, right-preconditioned with the same system for a
+// local (scalar, self) mobility M_loc = diag(β m_t I, β m_r I):
+//   P = (I + Δt K M_loc)⁻¹     (block-tridiagonal periodic, one sparse LU per refresh of K)
+// starting from g₀ = P F. With no Krylov iteration (krylov_max_iter = 0) the step is the IMEX
+// scheme "implicit force, explicit mobility":
+//   g = (I + Δt K M_loc)⁻¹ F(qⁿ),  δ = Δt M g                                             (2)
+// — one Stokes solve per step, and the rod still moves with the interpolated fluid velocity of
+// the force it spreads. Both are first order for any M_loc and any approximation of K (they
+// differ from forward Euler by O(Δt²)); stability needs M_loc K ≈ M K on the stiff modes
+// (docs/large_dt.md: β ≥ ~½ max M(q)/m over the modes that Δt makes stiff).
+// Finally X ← X + δ_X, D ← R(δ_θ) D (Rodrigues): the link is conserved as long as the rod does
+// not pass through itself, and the triads stay orthonormal.
+#include <Eigen/Sparse>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseLU>
+#include <memory>
+#include <vector>
+
+#include "integrate/adaptive_dt.hpp"
+#include "integrate/block_cyclic.hpp"
+#include "integrate/stepper.hpp"
+
+namespace ibrod::integrate {
+
+struct ImplicitParams {
+  double mobility_scale = 2.0;   ///< β: M_loc = β × the kernel's self mobility (≥ 0)
+  int krylov_max_iter = 0;       ///< GMRES iterations after the IMEX guess (0: scheme (2))
+  double krylov_tol = 1e-2;      ///< relative residual of (1) at which GMRES stops
+  /// trial steps between refreshes of K and of its factorisation (≥ 1; K at qⁿ when refreshed,
+  /// and whenever Δt changes). 1: K is a function of the state alone, so a run resumed from any
+  /// checkpoint (a signal's too) is bitwise the same. > 1 saves ~1.4 ms per step at the 64³
+  /// reference (4: 5.3–5.5 against 7.0–7.1 ms, the same accuracy; docs/large_dt.md), and then
+  /// only resumes from the periodic checkpoints are bitwise (Simulation::checkpoint_taken).
+  int jacobian_every = 1;
+  bool velocity_form = true;     ///< (I + Δt M_loc K) u = M F (true) or (I + Δt K M_loc) g = F
+  bool gauss_newton = true;      ///< K = Δs Σ Jᵀ C J (positive semi-definite) instead of −∂F/∂q
+  bool stiffness_fd = false;     ///< Gauss–Newton K by finite differences (else small-strain
+                                 ///< analytic strain Jacobian, O(n))
+  /// without contacts, solve the local system with BlockCyclicCholesky (else the general sparse
+  /// Cholesky; the same solution to round-off)
+  bool block_solver = true;
+  bool steric_implicit = true;   ///< add the steric contacts' stiffness to K
+  double fd_dx = 1e-4;           ///< finite-difference step of K in positions, Å
+  double fd_dtheta = 1e-5;       ///< ... and in rotation vectors, rad
+};
+
+/// What one implicit step did (for the adaptive controller and the logs).
+struct ImplicitStepInfo {
+  int krylov_iterations = 0;    ///< GMRES iterations (0 for the IMEX scheme)
+  int fluid_solves = 0;         ///< Stokes solves this step (1 + iterations)
+  bool converged = true;        ///< residual ≤ krylov_tol (always true with krylov_max_iter = 0)
+  double residual = 0;          ///< relative residual of (1) at the end (−1: not computed)
+  double max_displacement = 0;  ///< max_k |δX_k|, Å
+  double max_rotation = 0;      ///< max_k |δθ_k|, rad
+  double energy_before = 0;     ///< potential energy (elastic + electrostatic + steric) at qⁿ,
+  double energy_after = 0;      ///<   and at qⁿ⁺¹, g Å² s⁻²
+  bool finite = true;           ///< qⁿ⁺¹ is finite
+  bool jacobian_refreshed = false;
+};
+
+/// Wall time spent in the parts of ImplicitStepper::step, accumulated, s.
+struct ImplicitTimings {
+  double forces = 0, stiffness = 0, factorize = 0, local_solve = 0, stokes = 0;
+};
+
+class ImplicitStepper {
+ public:
+  /// Uses `stepper`'s serial fluid (not distributed), coupling and force modules; the fluid's
+  /// velocity array becomes the Stokes velocity of the latest solve. Two Stokes solves here
+  /// measure the self mobilities.
+  ImplicitStepper(Stepper& stepper, const ImplicitParams& p);
+  ~ImplicitStepper();
+
+  /// One implicit step of size dt (s): rod from qⁿ to qⁿ⁺¹. Returns what it did. The forces at
+  /// qⁿ⁺¹ are computed here (for energy_after) and kept for the next step, so a step costs one
+  /// force evaluation and 1 + krylov_iterations Stokes solves. The potential energies at qⁿ are
+  /// in last_energies().
+  ImplicitStepInfo step(rod::RodState& s, double dt);
+  /// Puts s back to qⁿ of the latest step (a rejected trial step); at most once per step.
+  void undo(rod::RodState& s);
+  /// The next step refreshes K (a resumed run and the run it continues then step alike: call it
+  /// where a checkpoint is written and after one is read).
+  void refresh_jacobian() { steps_since_jacobian_ = 0; }
+
+  /// (U, W) = M (F, T) at positions X: one Stokes solve (MODEL §4 spreading and interpolation,
+  /// ρ dropped). Å s⁻¹, s⁻¹.
+  void mobility(std::span<const Vec3> X, std::span<const Vec3> F, std::span<const Vec3> T,
+                std::span<Vec3> U, std::span<Vec3> W);
+
+  /// The elastic stiffness at s, [6n × 6n], per point (x, y, z, θx, θy, θz); units g s⁻²,
+  /// g Å s⁻², g Å² s⁻²: the Gauss–Newton K = Δs Σ_h J_hᵀ C J_h with the small-strain analytic
+  /// strain Jacobian (default), or by central finite differences over a colouring of the rod
+  /// (F_k, T_k depend on points k−1..k+1 only): Gauss–Newton (stiffness_fd) or the full
+  /// −∂(F, T)/∂(X, θ) (gauss_newton = false). Plus the stiffness of the steric contacts
+  /// (positions only; see implicit.cpp).
+  Eigen::SparseMatrix<double> stiffness(const rod::RodState& s);
+
+  double self_mobility_translation() const { return m_t_; }  ///< Å s⁻¹ per g Å s⁻²
+  double self_mobility_rotation() const { return m_r_; }     ///< s⁻¹ per g Å² s⁻²
+  const ImplicitParams& params() const { return p_; }
+  const StepEnergies& last_energies() const { return last_; }
+  const std::vector<Vec3>& velocities() const { return U_; }          ///< [n] δX/Δt, Å s⁻¹
+  const std::vector<Vec3>& angular_velocities() const { return W_; }  ///< [n] δθ/Δt, s⁻¹
+  Stepper& base() { return st_; }
+  int contacts() const { return contacts_; }
+  const ImplicitTimings& timings() const { return timings_; }  ///< steric segment contacts in the latest K
+
+ private:
+  Stepper& st_;
+  ImplicitParams p_;
+  int n_;
+  double m_t_ = 0, m_r_ = 0;   // self mobilities
+  double scale_t_ = 1;         // GMRES weight of torques: 1/ℓ, ℓ = √(m_t/m_r)
+  Eigen::SparseMatrix<double> K_;
+  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu_;             // full K (not symmetric)
+  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> llt_;        // Gauss–Newton K
+  Eigen::VectorXd mloc_;                                         // diagonal of M_loc
+  std::vector<Eigen::Matrix<double, 6, 6>> Kd_, Ko_;  // GN K blocks: K[k][k], K[k+1][k]
+  BlockCyclicCholesky bcc_;                          // their local system, no contacts
+  std::vector<Eigen::Matrix<double, 6, 6>> sdiag_, slower_;  // its blocks (scratch)
+  bool use_blocks_ = false, have_K_ = false;
+  void gn_blocks(const rod::RodState& s);            // fills Kd_, Ko_
+  Eigen::VectorXd local_solve(const Eigen::VectorXd& v) const;   // (I + Δt M_loc K)⁻¹ v
+  bool pattern_ready_ = false;
+  Eigen::Index pattern_nnz_ = 0;
+  int contacts_ = 0, pattern_contacts_ = 0;  // steric contacts in K, in the analysed pattern
+  double lu_dt_ = -1;          // dt of the current factorisation (−1: none)
+  long steps_since_jacobian_ = 0;
+  StepEnergies last_;
+  ImplicitTimings timings_;
+  rod::RodWork work_;
+  std::vector<Vec3> U_, W_, Fa_, Ta_, Fb_, Tb_;
+  rod::RodState pert_;
+  // forces at the state `cur_` (valid if has_cur_), and at the state before the latest step
+  struct Cached {
+    rod::RodState q;
+    std::vector<Vec3> F, T;
+    StepEnergies E;
+  };
+  Cached cur_, prev_;
+  bool has_cur_ = false, has_prev_ = false;
+  const Cached& forces_at(const rod::RodState& s);
+  void factorize(double dt);
+};
+
+/// An accepted step under the controller: tries min(ctl.dt(), cap) (cap: e.g. the time left to
+/// the next output, s), undoes and retries rejected trials. Returns the accepted step's info;
+/// *dt_taken its Δt, *rejected the trials undone. Throws ibrod::RunError after 60 rejections in
+/// a row (the controller's floor normally ends them long before).
+ImplicitStepInfo step_adaptive(ImplicitStepper& stepper, rod::RodState& s, AdaptiveDt& ctl,
+                               double cap, double* dt_taken, int* rejected = nullptr);
+
+/// The controller's view of a step.
+StepOutcome outcome(const ImplicitStepInfo& info);
+
+/// The implicit scheme as a time integrator (`time.scheme = "implicit"`): an ImplicitStepper
+/// driven by an AdaptiveDt. Its evolving state, besides the rod, is the controller's next Δt and
+/// its count of accepted steps in a row (checkpoint them with state() and put them back with
+/// restore(); K is then refreshed at the next step, so call restore() — or refresh() — at the
+/// same point of the uninterrupted run as well, e.g. whenever a checkpoint is written).
+class ImplicitIntegrator {
+ public:
+  struct State {
+    double next_dt = 0;          ///< s
+    int accepted_in_a_row = 0;
+  };
+  ImplicitIntegrator(Stepper& stepper, const ImplicitParams& p, const AdaptiveDtParams& a);
+
+  /// One accepted step of at most max_dt (s; e.g. the time left to t_end): returns its Δt.
+  double advance(rod::RodState& s, double max_dt);
+  const ImplicitStepInfo& last_info() const { return info_; }
+  int last_rejections() const { return rejected_; }
+  long rejections() const { return ctl_.rejections(); }
+
+  State state() const { return {ctl_.dt(), ctl_.accepted_in_a_row()}; }
+  void restore(const State& st);
+  void refresh() { stepper_.refresh_jacobian(); }
+  ImplicitStepper& stepper() { return stepper_; }
+  const AdaptiveDt& controller() const { return ctl_; }
+
+ private:
+  ImplicitStepper stepper_;
+  AdaptiveDt ctl_;
+  ImplicitStepInfo info_;
+  int rejected_ = 0;
+};
+
+}  // namespace ibrod::integrate

@@ -1,0 +1,54 @@
+// The time-scheme keys of issue 14: time.scheme takes "explicit" or "implicit" and nothing else,
+// the implicit knobs reach SimParams in internal units, and every key is described.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "config/config.hpp"
+#include "core/error.hpp"
+
+using namespace ibrod;
+using ::testing::HasSubstr;
+
+TEST(SchemeKeys, ExplicitByDefaultImplicitOnRequest) {
+  config::Config c;
+  EXPECT_EQ(config::to_params(c).scheme, sim::TimeScheme::explicit_step);
+  config::apply_override(c, "time.scheme=\"implicit\"");
+  config::apply_override(c, "time.max_displacement_A=1.5");
+  config::apply_override(c, "time.energy_tolerance_kT=0.01");
+  config::apply_override(c, "time.dt_min_ns=0.01");
+  config::apply_override(c, "time.implicit_mobility_scale=6");
+  config::apply_override(c, "time.implicit_jacobian_every=2");
+  config::apply_override(c, "time.implicit_krylov_iterations=5");
+  config::validate(c);
+  const sim::SimParams p = config::to_params(c);
+  EXPECT_EQ(p.scheme, sim::TimeScheme::implicit_step);
+  EXPECT_DOUBLE_EQ(p.adaptive.max_displacement, 1.5);
+  EXPECT_DOUBLE_EQ(p.adaptive.energy_tolerance, 0.01 * p.kT);
+  EXPECT_DOUBLE_EQ(p.adaptive.dt_min, 1e-11);
+  EXPECT_DOUBLE_EQ(p.implicit.mobility_scale, 6);
+  EXPECT_EQ(p.implicit.jacobian_every, 2);
+  EXPECT_EQ(p.implicit.krylov_max_iter, 5);
+  EXPECT_THAT(config::to_toml(c), HasSubstr("scheme = 'implicit'"));
+  for (const char* k : {"time.scheme", "time.max_displacement_A", "time.energy_tolerance_kT",
+                        "time.dt_min_ns", "time.implicit_mobility_scale",
+                        "time.implicit_jacobian_every", "time.implicit_krylov_iterations",
+                        "time.implicit_krylov_tol"})
+    EXPECT_THAT(config::describe(c), HasSubstr(k));
+}
+
+TEST(SchemeKeys, AnUnknownSchemeOrABadKnobNamesTheKey) {
+  config::Config c;
+  try {
+    config::apply_override(c, "time.scheme=\"semi\"");
+    FAIL() << "accepted time.scheme = \"semi\"";
+  } catch (const ConfigError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("time.scheme"));
+    EXPECT_THAT(e.what(), HasSubstr("implicit"));
+  }
+  EXPECT_THROW(config::apply_override(c, "time.scheme=1"), ConfigError);
+  EXPECT_THROW(config::apply_override(c, "time.implicit_jacobian_every=0"), ConfigError);
+  EXPECT_THROW(config::apply_override(c, "time.max_displacement_A=-1"), ConfigError);
+  config::apply_override(c, "time.scheme=\"implicit\"");
+  config::apply_override(c, "time.dt_min_ns=1");  // above time.dt_ns = 0.1
+  EXPECT_THROW(config::validate(c), ConfigError);
+}
