@@ -1,3 +1,5 @@
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -440,6 +442,18 @@ void apply_override(Config& c, const std::string& assignment) {
   try {
     t = toml::parse("v = " + value, "--set " + key);
   } catch (const toml::parse_error& e) {
+    // a bare word is a string, as people type it (--set time.scheme=implicit); a key that is not
+    // a string then says what it expects
+    const bool word =
+        !value.empty() && std::isalpha(static_cast<unsigned char>(value[0])) &&
+        std::all_of(value.begin(), value.end(), [](char ch) {
+          return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-';
+        });
+    if (word) {
+      t = toml::parse("v = \"" + value + "\"", "--set " + key);
+      set_key(c, key, *t.get("v"));
+      return;
+    }
     throw ConfigError("config: --set " + echo(key) + "=" + echo(value) +
                       ": the value is not a TOML number, boolean, string or array (" +
                       echo(std::string(e.description()), 200) + ")");

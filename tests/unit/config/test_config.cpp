@@ -131,3 +131,15 @@ TEST(Config, ResolvedTomlRoundTrips) {
   EXPECT_EQ(config::describe(c), config::describe(d));
   EXPECT_NE(config::describe(c), config::describe(config::Config{}));
 }
+
+TEST(Config, ABareWordInSetIsAStringAndAWrongTypeStillNamesTheKey) {
+  config::Config c;
+  config::apply_override(c, "time.scheme=implicit");
+  EXPECT_EQ(c.time_scheme, "implicit");
+  try {
+    config::apply_override(c, "grid.n=sixteen");
+    FAIL() << "grid.n=sixteen accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("grid.n"), std::string::npos) << e.what();
+  }
+}
