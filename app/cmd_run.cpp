@@ -25,6 +25,7 @@ namespace driver = ibrod::driver;
 
 struct ConfigArgs {
   std::string config_path;
+  bool config_given = false;  ///< CONFIG was on the command line (perhaps as "")
   std::vector<std::string> sets;
 };
 
@@ -40,6 +41,10 @@ struct BenchArgs : ConfigArgs {
 };
 
 cfg::Config resolve(const ConfigArgs& a) {
+  // `ibrod run ""` is not `ibrod run`: an empty path is refused, not read as "defaults"
+  if (a.config_given && a.config_path.empty())
+    throw ibrod::ConfigError("config: cannot read file '': the path is empty (omit CONFIG for "
+                             "the built-in reference run)");
   cfg::Config c = cfg::load_config(a.config_path);
   for (const auto& s : a.sets) cfg::apply_override(c, s);
   cfg::validate(c);
@@ -47,7 +52,8 @@ cfg::Config resolve(const ConfigArgs& a) {
 }
 
 void add_config_args(CLI::App* cmd, ConfigArgs& a) {
-  cmd->add_option("config", a.config_path, "TOML config (default: the built-in reference run)");
+  cmd->add_option("config", a.config_path, "TOML config (default: the built-in reference run)")
+      ->each([&a](const std::string&) { a.config_given = true; });
   cmd->add_option("--set", a.sets, "override one key: section.key=value (repeatable)");
 }
 
@@ -82,6 +88,8 @@ int run_main(RunArgs a) {
     opt.fftw_wisdom = a.wisdom;
     opt.rank = world.rank;
     opt.ranks = world.size;
+    // the memory a run needs against what this process may allocate, before any of it is
+    cfg::check_memory(c, world.size);
     const driver::RunResult r = driver::run(c, opt);
     if (r.signal != 0 && world.rank == 0) {
       std::fprintf(stderr,
@@ -100,6 +108,12 @@ int check_main(const ConfigArgs& a) {
     const cfg::Config c = resolve(a);
     std::printf("# resolved configuration\n%s\n# derived quantities\n%s",
                 cfg::describe(c).c_str(), cfg::derived_report(c).c_str());
+    // a config may be meant for a larger machine: `check` warns where `run` would refuse
+    try {
+      cfg::check_memory(c);
+    } catch (const ibrod::ConfigError& e) {
+      std::printf("# warning: `ibrod run` here would refuse: %s\n", e.what());
+    }
     return 0;
   } catch (const std::exception& e) {
     return ibrod::app::report_error(e);
@@ -110,6 +124,7 @@ int bench_main(const BenchArgs& a) {
   try {
     cfg::Config c = resolve(a);
     if (a.threads > 0) c.run_threads = a.threads;
+    cfg::check_memory(c);
     if (a.schemes) {
       driver::print_bench_schemes(
           driver::bench_schemes(c, a.steps, a.implicit_dt_ns, a.implicit_ns), stdout);

@@ -18,6 +18,7 @@ struct SweepArgs {
   std::string file, output;
   int jobs = 1;
   bool list = false;
+  long point = -1;  ///< --point K: this point alone (a scheduler's job array); −1: all
 };
 
 int sweep_main(const SweepArgs& a) {
@@ -39,9 +40,16 @@ int sweep_main(const SweepArgs& a) {
     if (a.list) {
       if (root)
         for (const auto& pt : sw.points)
-          std::printf("%-40s %s\n", pt.name.c_str(),
+          std::printf("%4zu  %-40s %s\n", pt.index, pt.name.c_str(),
                       ibrod::driver::to_string(ibrod::driver::point_state(opt.output_root / pt.name)));
       return 0;
+    }
+    if (a.point >= 0) {
+      if (std::size_t(a.point) >= sw.points.size())
+        throw ibrod::ConfigError("sweep: --point " + std::to_string(a.point) + " is not a point of " +
+                                 a.file + ": its points are 0 to " +
+                                 std::to_string(sw.points.size() - 1) + " (--list shows them)");
+      opt.only_point = a.point;
     }
     opt.jobs = a.jobs;
     opt.rank = world.rank;
@@ -55,11 +63,15 @@ int sweep_main(const SweepArgs& a) {
     const long long points = ibrod::driver::mpi::sum(r.points);
     const long long completed = ibrod::driver::mpi::sum(r.completed);
     const long long skipped = ibrod::driver::mpi::sum(r.skipped);
+    const long long elsewhere = ibrod::driver::mpi::sum(r.running);
     if (world.size > 1 && root)
       std::printf("sweep: all ranks: %lld points, %lld finished now, %lld already finished, %lld "
                   "failed\n",
                   points, completed, skipped, failed);
-    status = sig ? 128 + int(sig) : failed > 0 ? 4 : 0;
+    if (elsewhere > 0 && root)
+      std::fprintf(stderr, "ibrod: sweep: %lld points are still being written by another process; "
+                           "run the sweep again when they are done\n", elsewhere);
+    status = sig ? 128 + int(sig) : (failed > 0 || elsewhere > 0) ? 4 : 0;
   } catch (const std::exception& e) {
     // a bad sweep file is the same on every rank: only rank 0 says so
     status = ibrod::app::report_error(e, root || !dynamic_cast<const ibrod::ConfigError*>(&e));
@@ -81,6 +93,11 @@ void add_sweep_command(CLI::App& app) {
   sweep->add_option("-o,--output", a->output,
                     "root of the point directories (default: `output_dir` of the sweep file, else "
                     "the sweep file's name without .toml)");
-  sweep->add_flag("--list", a->list, "print every point's name and state, run nothing");
+  sweep->add_flag("--list", a->list, "print every point's index, name and state, run nothing");
+  sweep->add_option("--point", a->point,
+                    "run point K alone (0-based, as --list numbers them), with the same naming, "
+                    "skipping and resuming rules: one task of a scheduler's job array "
+                    "(e.g. --point $SLURM_ARRAY_TASK_ID)")
+      ->check(CLI::NonNegativeNumber);
   sweep->callback([a] { throw CLI::RuntimeError(sweep_main(*a)); });
 }

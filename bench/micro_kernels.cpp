@@ -203,7 +203,7 @@ BENCHMARK(BM_FluidStep)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
 void BM_Writhe(benchmark::State& st) {
   const auto p = config::to_params(reference(64, int(st.range(0))));
   const auto s = ring(p);
-  for (auto _ : st) benchmark::DoNotOptimize(diag::writhe(s.X));
+  for (auto _ : st) benchmark::DoNotOptimize(diagnostics::writhe(s.X));
 }
 BENCHMARK(BM_Writhe)->Arg(600)->Arg(6000)->Unit(benchmark::kMillisecond)->UseRealTime();
 

@@ -95,10 +95,10 @@ int main(int argc, char** argv) {
         smin = std::min(smin, sp);
         smax = std::max(smax, sp);
       }
-      const double wr = diag::writhe(rod.X), lk = wr + diag::twist(rod.X, d1);
+      const double wr = diagnostics::writhe(rod.X), lk = wr + diagnostics::twist(rod.X, d1);
       if (s == 0) lk0 = lk;
       std::printf("%.3f %.5f %.6f %.4f %.3f %.4f %.4f %ld %ld %.4f %.4g\n", t * 1e9, wr, lk,
-                  potential(), diag::closest_approach(rod.X, 20), smin, smax, iters, solves,
+                  potential(), diagnostics::closest_approach(rod.X, 20), smin, smax, iters, solves,
                   maxdisp, (adaptive ? ctl.dt() : dt) * 1e9);
       while (next_out <= t + 1e-6 * dt) next_out += out;
       if (!std::isfinite(wr) || smax > 1.5 * p.stepper.rod.ds || smin < 0.5 * p.stepper.rod.ds ||

@@ -28,7 +28,7 @@ using json = nlohmann::ordered_json;
 
 namespace {
 
-FitWindow fit_window(const diag::LineFit& f, std::span<const double> t, double tolerance) {
+FitWindow fit_window(const diagnostics::LineFit& f, std::span<const double> t, double tolerance) {
   return {t[f.first], t[f.first + f.count - 1], f.count, f.r2, f.max_abs_residual,
           f.max_abs_residual <= tolerance};
 }
@@ -95,13 +95,13 @@ Analysis analyze_timeseries(const CsvTable& table, const AnalyzeOptions& opt) {
   a.rows = n;
 
   a.writhe_final = wr[last];
-  a.writhe_convergence_time_us = diag::writhe_convergence_time(t, wr, opt.writhe_delta);
+  a.writhe_convergence_time_us = diagnostics::writhe_convergence_time(t, wr, opt.writhe_delta);
 
-  if (const auto fit = diag::relaxation_time(t, ek, opt.fit)) {
+  if (const auto fit = diagnostics::relaxation_time(t, ek, opt.fit)) {
     a.relaxation_time_us = fit->tau;
     a.relaxation_fit = fit_window(fit->line, t, opt.fit.tolerance);
   }
-  for (const auto& s : diag::transients(t, ek, et, opt.transients))
+  for (const auto& s : diagnostics::transients(t, ek, et, opt.transients))
     a.transients.push_back({s.time, s.kinetic, s.total, wr[s.index], s.plateau_start, s.plateau_end});
 
   a.closest_approach_A = ca[last];
@@ -117,7 +117,7 @@ Analysis analyze_timeseries(const CsvTable& table, const AnalyzeOptions& opt) {
   for (double w : wr) max_wr = std::max(max_wr, std::abs(w));
   a.stays_circular = max_wr < opt.circular_writhe;
   if (a.stays_circular) {
-    if (const auto fit = diag::power_law_exponent(t, ek, opt.fit)) {
+    if (const auto fit = diagnostics::power_law_exponent(t, ek, opt.fit)) {
       a.kinetic_power_law_exponent = fit->exponent;
       a.kinetic_power_law_fit = fit_window(fit->line, t, opt.fit.tolerance);
     }

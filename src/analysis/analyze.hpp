@@ -35,11 +35,11 @@ RunInfo read_run_info(const std::filesystem::path& dir);
 struct AnalyzeOptions {
   double writhe_delta = 0.01;           ///< δ of the writhe convergence time
   double circular_writhe = 0.05;        ///< a run "stays circular" while |Wr| < this throughout
-  diag::WindowOptions fit;              ///< final-window fits (ln E_K; tolerance in ln units)
-  diag::TransientOptions transients;
+  diagnostics::WindowOptions fit;              ///< final-window fits (ln E_K; tolerance in ln units)
+  diagnostics::TransientOptions transients;
 };
 
-/// The window and quality of a final-window fit (diag::fit_final_linear_window).
+/// The window and quality of a final-window fit (diagnostics::fit_final_linear_window).
 struct FitWindow {
   double t_start_us = 0, t_end_us = 0;
   std::size_t points = 0;
@@ -48,7 +48,7 @@ struct FitWindow {
   bool within_tolerance = false;
 };
 
-/// A transient state (diag::transients) with the writhe at its E_K minimum.
+/// A transient state (diagnostics::transients) with the writhe at its E_K minimum.
 struct TransientState {
   double time_us = 0, E_kinetic_kT = 0, E_total_kT = 0, writhe = 0;
   double plateau_start_us = 0, plateau_end_us = 0;

@@ -12,6 +12,17 @@
 
 namespace ibrod::config {
 
+// Bounds on what a run may ask for (docs/config.md, "Bounds"); validate() refuses beyond them.
+inline constexpr double kMinDtNs = 1e-6;    ///< time.dt_ns at least 1 fs
+inline constexpr double kMaxDtNs = 1e6;     ///< time.dt_ns at most 1 ms
+inline constexpr double kMaxSteps = 1e12;   ///< time steps t_end/Δt (int64 with a wide margin)
+inline constexpr double kMaxOutputBytes = 1125899906842624.0;  ///< 1 PiB of rows and frames
+/// Largest twist between neighbouring triads, rad: the twist strain is 2 sin(θ/2)/Δs, which is
+/// within 10% of θ/Δs for |θ| ≤ π/2 and not invertible past π (rod/rod.cpp eval_half).
+inline constexpr double kMaxTwistPerSegment = 1.5707963267948966;
+/// grid.box_A / rod.rise_A at most: positions of size L keep ≥ 6 digits of a segment Δs.
+inline constexpr double kMaxBoxPerRise = 1e9;
+
 struct Config {
   // [grid]
   int grid_n = 64;                 ///< grid.n: points per box edge (even, ≥ 8)
@@ -29,6 +40,11 @@ struct Config {
   int time_implicit_jacobian_every = 1;      ///< implicit: steps between stiffness refreshes
   int time_implicit_krylov_iterations = 0;   ///< implicit: GMRES iterations (0: IMEX)
   double time_implicit_krylov_tol = 1e-2;    ///< implicit: GMRES relative residual
+  bool time_stability_test = true;         ///< test a state before calling it an equilibrium
+  double time_stability_amplitude_rad = 0.05;  ///< twist perturbation of the test, rad
+  double time_stability_probe_us = 0.5;        ///< how long the perturbed copy is integrated, µs
+  double time_stability_tolerance_kT = 1e-3;   ///< an energy drop beyond this: unstable, kT
+  std::int64_t time_stability_seed = 1;        ///< seed of the test's perturbation
   // [rod]
   int rod_base_pairs = 600;        ///< rod.base_pairs: rod points n
   int rod_excess_link = 6;         ///< rod.excess_link: ΔLk (integer)
@@ -93,10 +109,29 @@ std::string describe(const Config& c);
 std::string config_differences(const std::string& old_toml, const Config& now,
                                const std::string& source);
 
+/// Whether `now` differs from the configuration `old_toml` in a later time.t_end_us alone (the
+/// extension of a run: `--resume DIR --set time.t_end_us=T` needs no --force).
+bool only_end_time_extended(const std::string& old_toml, const Config& now,
+                            const std::string& source);
+
 /// Convert to internal units (g, Å, s) for the simulation.
 sim::SimParams to_params(const Config& c);
 
 /// Derived quantities for `ibrod check`: h, c, Δs, r0, 1/κ, Bjerrum length, steps, memory.
 std::string derived_report(const Config& c);
+
+/// Bytes one process of a run holds (the fluid's arrays split over `ranks` x-slabs, the rod, and
+/// a fixed allowance for the program itself); the "memory estimate" of `ibrod check`.
+double memory_estimate_bytes(const Config& c, int ranks = 1);
+/// Bytes of time-series rows and trajectory frames (H5MD, .vtp, .vti) a run to t_end writes.
+double output_estimate_bytes(const Config& c);
+
+/// What this process may allocate, bytes: the least of physical memory, the cgroup's
+/// memory.max, and RLIMIT_AS / RLIMIT_DATA less what is mapped already; `why` names which.
+double memory_available_bytes(std::string* why = nullptr);
+/// Throws ConfigError naming grid.n (or rod.base_pairs) and the memory needed when
+/// memory_estimate_bytes(c, ranks) exceeds memory_available_bytes() (before anything is
+/// allocated, so that a run never ends in std::bad_alloc for want of memory it could foresee).
+void check_memory(const Config& c, int ranks = 1);
 
 }  // namespace ibrod::config

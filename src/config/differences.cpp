@@ -31,4 +31,17 @@ std::string config_differences(const std::string& old_toml, const Config& now,
   return out;
 }
 
+bool only_end_time_extended(const std::string& old_toml, const Config& now,
+                            const std::string& source) {
+  Config old;
+  try {
+    apply_toml(old, old_toml, source);
+  } catch (const ConfigError&) {
+    return false;
+  }
+  if (!(now.time_t_end_us > old.time_t_end_us)) return false;
+  old.time_t_end_us = now.time_t_end_us;
+  return describe(old) == describe(now);
+}
+
 }  // namespace ibrod::config

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -22,18 +23,56 @@ void validate(const Config& c) {
         "an integer m with 4m + 2 <= grid.n = " + std::to_string(c.grid_n) +
             " (the kernel must fit in the grid)");
   const double r0 = rod::circle_radius(c.rod_base_pairs, c.rod_rise_A);
-  const double extent = 2 * r0 + c.steric_diameter_A;
-  if (extent >= c.grid_box_A)
+  // The ring plus its hard core must fit in the box; the key blamed is the one that grew past
+  // it: the hard core when the bare ring fits, else the box (naming the ring's keys).
+  if (2 * r0 < c.grid_box_A && 2 * r0 + c.steric_diameter_A >= c.grid_box_A)
+    bad("steric.diameter_A", fmt(c.steric_diameter_A),
+        "a hard core that leaves the ring (diameter " + fmt(2 * r0) +
+            " Å) inside the box: steric.diameter_A < grid.box_A - 2 r0 = " +
+            fmt(c.grid_box_A - 2 * r0) + " Å");
+  if (2 * r0 + c.steric_diameter_A >= c.grid_box_A)
     bad("grid.box_A", fmt(c.grid_box_A),
         "a box larger than the ring: rod.base_pairs = " + std::to_string(c.rod_base_pairs) +
             " at rod.rise_A = " + fmt(c.rod_rise_A) + " gives a ring of diameter " +
-            fmt(2 * r0) + " Å (plus the hard core " + fmt(c.steric_diameter_A) + " Å)");
+            fmt(2 * r0) + " Å (plus the hard core steric.diameter_A = " +
+            fmt(c.steric_diameter_A) + " Å)");
+  if (c.grid_box_A > kMaxBoxPerRise * c.rod_rise_A)
+    bad("grid.box_A", fmt(c.grid_box_A),
+        "at most " + fmt(kMaxBoxPerRise) + " rod.rise_A = " +
+            fmt(kMaxBoxPerRise * c.rod_rise_A) +
+            " Å (positions of that size keep 6 digits of a segment in double precision)");
   if (c.time_scheme == "implicit" && c.time_dt_min_ns > c.time_dt_ns)
     bad("time.dt_min_ns", fmt(c.time_dt_min_ns),
         "at most time.dt_ns = " + fmt(c.time_dt_ns) + " ns (the implicit scheme's largest step)");
   if (c.time_dt_ns * 1e-3 > c.time_t_end_us)
     bad("time.t_end_us", fmt(c.time_t_end_us),
         "at least one time step (time.dt_ns = " + fmt(c.time_dt_ns) + " ns)");
+  // Derived counts, in double so that nothing overflows before it is compared (MODEL: the
+  // run takes steps_to_reach(t_end, Δt) steps; rows and frames follow from it).
+  const double steps = c.time_t_end_us * 1e3 / c.time_dt_ns;
+  if (!(steps <= kMaxSteps))
+    bad("time.t_end_us", fmt(c.time_t_end_us),
+        "at most " + fmt(kMaxSteps) + " time steps of time.dt_ns = " + fmt(c.time_dt_ns) +
+            " ns, i.e. time.t_end_us <= " + fmt(kMaxSteps * c.time_dt_ns * 1e-3) + " (asked: " +
+            fmt(steps) + " steps)");
+  if (const double bytes = output_estimate_bytes(c); !(bytes <= kMaxOutputBytes)) {
+    const bool frames = frame_every(c) > 0;
+    bad(frames ? "output.frame_every_steps" : "output.every_steps",
+        std::to_string(frames ? frame_every(c) : c.output_every_steps),
+        "rows and frames of at most 1 PiB in all to time.t_end_us = " + fmt(c.time_t_end_us) +
+            " (asked: " + fmt(bytes / 1099511627776.0) + " TiB); write less often");
+  }
+  // The discretization represents a twist of at most kMaxTwistPerSegment between neighbours:
+  // the circle's twist 2π ΔLk / n and the reference twist Ω³₀ Δs.
+  const double max_link = kMaxTwistPerSegment * c.rod_base_pairs / (2 * std::acos(-1.0));
+  if (std::abs(c.rod_excess_link) > max_link)
+    bad("rod.excess_link", std::to_string(c.rod_excess_link),
+        "|ΔLk| <= rod.base_pairs / 4 = " + fmt(std::floor(max_link)) +
+            " (a twist of at most π/2 between neighbouring triads; docs/config.md)");
+  if (std::abs(c.rod_intrinsic_twist_per_A) * c.rod_rise_A > kMaxTwistPerSegment)
+    bad("rod.intrinsic_twist_per_A", fmt(c.rod_intrinsic_twist_per_A),
+        "|Ω³₀| <= π / (2 rod.rise_A) = " + fmt(kMaxTwistPerSegment / c.rod_rise_A) +
+            " rad/Å (a twist of at most π/2 between neighbouring triads; docs/config.md)");
   // MODEL §5: sin β must be a sine
   const double a = c.rod_bend_modulus_erg_cm * units::erg_cm;
   const double a3 = c.rod_twist_modulus_erg_cm * units::erg_cm;
@@ -82,6 +121,11 @@ sim::SimParams to_params(const Config& c) {
   p.circle.center = Vec3::Constant(0.5 * s.grid.L);
   p.t_end = c.time_t_end_us * us;
   p.stop_kinetic = c.time_stop_kinetic_kT * p.kT;
+  p.stability.enabled = c.time_stability_test;
+  p.stability.amplitude = c.time_stability_amplitude_rad;
+  p.stability.time = c.time_stability_probe_us * us;
+  p.stability.tolerance = c.time_stability_tolerance_kT * p.kT;
+  p.stability.seed = std::uint64_t(c.time_stability_seed);
   p.output.rows = c.output_every_steps;
   p.output.frames = frame_every(c);
   p.output.checkpoints = c.output_checkpoint_every_steps;
@@ -100,6 +144,29 @@ sim::SimParams to_params(const Config& c) {
 }
 
 
+double memory_estimate_bytes(const Config& c, int ranks) {
+  const double n = c.grid_n;
+  // velocity + force (3 real arrays each) + spectrum (3 complex half arrays), split over ranks
+  const double fluid = 8.0 * (6 * n * n * n + 2 * 3 * n * n * (n / 2 + 1)) / std::max(ranks, 1);
+  // measured at grid.n = 128: 167 MiB resident against 145 MiB of arrays
+  const double program = 32.0 * (1 << 20);
+  return fluid + 400.0 * c.rod_base_pairs + program;
+}
+
+
+double output_estimate_bytes(const Config& c) {
+  const double steps = std::ceil(c.time_t_end_us * 1e3 / c.time_dt_ns);
+  const double rows = steps / double(c.output_every_steps) + 1;
+  const std::int64_t every = frame_every(c);
+  const double frames = every > 0 ? steps / double(every) + 1 : 0;
+  // docs/outputs.md: a row ≈ 400 bytes of text; a frame 96 n (H5MD) + 270 n (.vtp) bytes, and
+  // ≈ 32 N³ more with output.fluid_vti (3 Float64 a grid point, base64)
+  const double n = c.grid_n;
+  const double frame = 366.0 * c.rod_base_pairs + (c.output_fluid_vti ? 32.0 * n * n * n : 0);
+  return rows * 400.0 + frames * frame;
+}
+
+
 std::string derived_report(const Config& c) {
   const auto p = to_params(c);
   const auto& s = p.stepper;
@@ -109,8 +176,6 @@ std::string derived_report(const Config& c) {
       rod::circle_tilt_sin_beta(s.rod.a[0], s.rod.a[2], s.rod.b[0], r0, c.rod_excess_link);
   const auto steps = sim::steps_to_reach(p.t_end, p.dt);
   const double N3 = double(s.grid.size());
-  // velocity + force (3 real arrays each) + spectrum (3 complex half arrays)
-  const double fluid_bytes = 8.0 * (6 * N3 + 2 * 3 * s.grid.n * s.grid.n * (s.grid.n / 2 + 1));
   std::ostringstream os;
   os.precision(5);
   os << "grid spacing h            = " << h << " Å\n"
@@ -128,13 +193,15 @@ std::string derived_report(const Config& c) {
      << "steric stiffness g        = " << s.steric.stiffness << " g s⁻²\n"
      << "time steps                = " << steps << "\n"
      << "diagnostics rows          = " << steps / p.output.rows + 1 << "\n"
-     << "memory estimate           = " << (fluid_bytes + 400.0 * s.rod.n) / (1 << 20) << " MiB\n";
+     << "memory estimate           = " << memory_estimate_bytes(c) / (1 << 20) << " MiB\n";
   // docs/outputs.md: checkpoint = 3 N³ velocities + 12 n rod numbers; a frame = 4 × n × 3 numbers
   const std::int64_t frames = p.output.frames > 0 ? steps / p.output.frames + 1 : 0;
   os << "checkpoint size           = " << (24.0 * N3 + 96.0 * s.rod.n) / (1 << 20) << " MiB\n"
      << "trajectory frames         = " << frames << " (H5MD ≈ "
      << frames * 96.0 * s.rod.n / (1 << 20) << " MiB, .vtp ≈ "
-     << frames * 270.0 * s.rod.n / (1 << 20) << " MiB)\n";
+     << frames * 270.0 * s.rod.n / (1 << 20) << " MiB)\n"
+     << "output estimate           = " << output_estimate_bytes(c) / (1 << 20)
+     << " MiB (rows and frames to t_end)\n";
   return os.str();
 }
 

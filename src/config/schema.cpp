@@ -18,6 +18,7 @@
 namespace ibrod::config {
 
 using detail::bad;
+using detail::echo;
 using detail::fmt;
 using rod::draw_perturbation;
 using rod::RandomPerturbation;
@@ -43,6 +44,7 @@ struct Key {
   std::function<void(Config&, const toml::node&)> set;
   std::function<void(const Config&, toml::table&)> put;  // into its section table
   std::function<std::string(const Config&)> value;
+  bool is_table = false;  // its value is a table whose sub-keys `--set name.sub=v` may set
 };
 
 std::string section_of(const std::string& k) { return k.substr(0, k.find('.')); }
@@ -141,6 +143,18 @@ Key real_array(std::string name, std::vector<double> Config::*m, double max_abs,
 
 const double inf = std::numeric_limits<double>::max();
 
+// A dimensional parameter of the model, within kDecades decades of its reference value (MODEL §1,
+// the default) either way. Why 20: a step forms products and quotients of at most about ten such
+// parameters (e.g. the kinetic energy ρ u² h³ with u ~ a Δt / (ρ Δs² h³)), so every intermediate
+// stays within 10^±200, inside the double range (10^±308) with a margin; and far outside any
+// physical value, so no real run is refused. `allow_zero`: 0 is allowed too (switches it off).
+constexpr double kDecades = 20;
+Key physical(std::string name, double Config::*m, double ref, bool allow_zero, std::string help) {
+  // widened by 1e-13 so that the bound as printed (12 digits) is itself accepted
+  const double f = std::pow(10.0, kDecades), lo = ref / f * (1 - 1e-13), hi = ref * f * (1 + 1e-13);
+  return real(std::move(name), m, allow_zero ? 0 : lo, false, hi, std::move(help));
+}
+
 // output.frame_every_steps: −1 (the default) follows output.every_steps; written back resolved, so
 // that config.toml holds the number of steps actually used.
 Key frame_key() {
@@ -175,7 +189,7 @@ Key scheme_key() {
 // rod.perturbation_random = { modes = M, amplitude = A, seed = S }: an inline table (a Key whose
 // value is a table). A partial table changes only the sub-keys it names, so that `--set
 // rod.perturbation_random.seed=7` (see set_key) works on top of a file's table. Written back as the
-// table; the drawn ε_m follow from it exactly (io/perturbation.hpp) and `ibrod check` shows them.
+// table; the drawn ε_m follow from it exactly (rod/perturbation.hpp) and `ibrod check` shows them.
 Key random_perturbation_key() {
   const std::string name = "rod.perturbation_random";
   const std::string help =
@@ -184,6 +198,7 @@ Key random_perturbation_key() {
   Key k;
   k.name = name;
   k.help = help;
+  k.is_table = true;
   k.set = [=](Config& c, const toml::node& n) {
     const toml::table* t = n.as_table();
     if (!t) bad(name, show(n), "an inline table { modes = M, amplitude = A, seed = S }");
@@ -205,7 +220,7 @@ Key random_perturbation_key() {
         if (sd < 0) bad(full, show(v), "an integer >= 0 (seed of std::mt19937_64)");
         r.seed = std::uint64_t(sd);
       } else {
-        throw ConfigError("config: unknown key '" + full + "' (keys in " + name +
+        throw ConfigError("config: unknown key '" + echo(full) + "' (keys in " + name +
                           ": modes, amplitude, seed)");
       }
     }
@@ -237,21 +252,22 @@ Key random_perturbation_key() {
 const std::vector<Key>& schema() {
   static const std::vector<Key> keys = {
       integer("grid.n", &Config::grid_n, 8, 1024, "grid points per box edge, even"),
-      real("grid.box_A", &Config::grid_box_A, 0, true, inf, "periodic box edge L, Å"),
+      physical("grid.box_A", &Config::grid_box_A, 725, false, "periodic box edge L, Å"),
       integer("grid.kernel_width", &Config::grid_kernel_width, 1, 16,
               "kernel width c/h, a positive integer"),
-      real("time.dt_ns", &Config::time_dt_ns, 0, true, inf, "time step Δt, ns"),
-      real("time.t_end_us", &Config::time_t_end_us, 0, true, inf, "simulated time, µs"),
-      real("time.stop_kinetic_kT", &Config::time_stop_kinetic_kT, 0, false, inf,
+      real("time.dt_ns", &Config::time_dt_ns, kMinDtNs, false, kMaxDtNs, "time step Δt, ns"),
+      real("time.t_end_us", &Config::time_t_end_us, 0, true, kMaxDtNs * 1e-3 * kMaxSteps,
+           "simulated time, µs"),
+      real("time.stop_kinetic_kT", &Config::time_stop_kinetic_kT, 0, false, 1e20,
            "stop when the fluid kinetic energy falls below this, kT (0: never)"),
       scheme_key(),
-      real("time.max_displacement_A", &Config::time_max_displacement_A, 0, false, inf,
+      real("time.max_displacement_A", &Config::time_max_displacement_A, 0, false, 1e4,
            "implicit: largest move of a rod point in one step, Å; a longer step is retried "
            "shorter (0: 0.2 min(Debye length, steric.diameter_A))"),
-      real("time.energy_tolerance_kT", &Config::time_energy_tolerance_kT, 0, false, inf,
+      real("time.energy_tolerance_kT", &Config::time_energy_tolerance_kT, 0, false, 1e6,
            "implicit: largest rise of the potential energy in one step, kT; a step that raises "
            "it more is retried shorter"),
-      real("time.dt_min_ns", &Config::time_dt_min_ns, 0, false, inf,
+      real("time.dt_min_ns", &Config::time_dt_min_ns, 0, false, kMaxDtNs,
            "implicit: smallest step, ns, always accepted (0: time.dt_ns/1000)"),
       real("time.implicit_mobility_scale", &Config::time_implicit_mobility_scale, 0, true, 1e6,
            "implicit: local mobility M_loc = this × the kernel's self mobility"),
@@ -263,6 +279,18 @@ const std::vector<Key>& schema() {
       real("time.implicit_krylov_tol", &Config::time_implicit_krylov_tol, 0, true, 1,
            "implicit: relative residual at which GMRES stops (not reached: the step is retried "
            "shorter)"),
+      boolean("time.stability_test", &Config::time_stability_test,
+              "test a state the kinetic-energy rule calls an equilibrium by perturbing a copy "
+              "(docs/config.md); false: stop at once"),
+      real("time.stability_amplitude_rad", &Config::time_stability_amplitude_rad, 0, true, 1.0,
+           "twist amplitude of the stability test's perturbation, rad"),
+      real("time.stability_probe_us", &Config::time_stability_probe_us, 0, true, 1e3,
+           "how long the stability test integrates the perturbed state, µs"),
+      real("time.stability_tolerance_kT", &Config::time_stability_tolerance_kT, 0, false, 1e6,
+           "energy drop during the stability test that makes a state unstable, kT"),
+      integer("time.stability_seed", &Config::time_stability_seed, 0,
+              std::numeric_limits<std::int64_t>::max(),
+              "seed of the stability test's perturbation"),
       integer("rod.base_pairs", &Config::rod_base_pairs, 8, 1000000,
               "rod points = base pairs n"),
       integer("rod.excess_link", &Config::rod_excess_link, -1000, 1000,
@@ -270,40 +298,40 @@ const std::vector<Key>& schema() {
       real_array("rod.perturbation", &Config::rod_perturbation, 100.0,
                  "twist perturbation amplitudes ε_m for m = 1, 2, …, rad"),
       random_perturbation_key(),
-      real("rod.rise_A", &Config::rod_rise_A, 0, true, inf, "rise per base pair Δs, Å"),
-      real("rod.bend_modulus_erg_cm", &Config::rod_bend_modulus_erg_cm, 0, true, inf,
-           "bending moduli a1 = a2, erg·cm"),
-      real("rod.twist_modulus_erg_cm", &Config::rod_twist_modulus_erg_cm, 0, true, inf,
-           "twist modulus a3, erg·cm"),
-      real("rod.shear_modulus_dyn", &Config::rod_shear_modulus_dyn, 0, true, inf,
-           "shear constants b1 = b2, dyn"),
-      real("rod.stretch_modulus_dyn", &Config::rod_stretch_modulus_dyn, 0, true, inf,
-           "stretch constant b3, dyn"),
+      physical("rod.rise_A", &Config::rod_rise_A, 3.4, false, "rise per base pair Δs, Å"),
+      physical("rod.bend_modulus_erg_cm", &Config::rod_bend_modulus_erg_cm, 1.3e-19, false,
+               "bending moduli a1 = a2, erg·cm"),
+      physical("rod.twist_modulus_erg_cm", &Config::rod_twist_modulus_erg_cm, 1.82e-19, false,
+               "twist modulus a3, erg·cm"),
+      physical("rod.shear_modulus_dyn", &Config::rod_shear_modulus_dyn, 5e-5, false,
+               "shear constants b1 = b2, dyn"),
+      physical("rod.stretch_modulus_dyn", &Config::rod_stretch_modulus_dyn, 5e-5, false,
+               "stretch constant b3, dyn"),
       real("rod.intrinsic_twist_per_A", &Config::rod_intrinsic_twist_per_A, -inf, false, inf,
            "intrinsic twist Ω³₀, rad/Å (0: untwisted reference)"),
       real("solvent.salt_M", &Config::solvent_salt_M, 0, false, 10.0,
            "monovalent salt concentration Cs, mol/L"),
-      real("solvent.viscosity_poise", &Config::solvent_viscosity_poise, 0, true, inf,
-           "viscosity μ, poise (g/(cm·s))"),
-      real("solvent.density_g_cm3", &Config::solvent_density_g_cm3, 0, true, inf,
-           "density ρ, g/cm³"),
-      real("solvent.temperature_K", &Config::solvent_temperature_K, 0, true, inf,
-           "temperature for kT, K"),
+      physical("solvent.viscosity_poise", &Config::solvent_viscosity_poise, 0.01, false,
+               "viscosity μ, poise (g/(cm·s))"),
+      physical("solvent.density_g_cm3", &Config::solvent_density_g_cm3, 1.0, false,
+               "density ρ, g/cm³"),
+      physical("solvent.temperature_K", &Config::solvent_temperature_K, 300, false,
+               "temperature for kT, K"),
       boolean("solvent.advection", &Config::solvent_advection,
               "include the nonlinear advection term ρ u·∇u"),
       boolean("electrostatics.enabled", &Config::electrostatics_enabled,
               "Debye–Hückel repulsion between rod points"),
-      real("electrostatics.charge_e", &Config::electrostatics_charge_e, 0, false, inf,
-           "net charge per base pair, e"),
-      real("electrostatics.dielectric", &Config::electrostatics_dielectric, 0, true, inf,
-           "dielectric constant of water εw"),
-      real("electrostatics.cutoff_debye", &Config::electrostatics_cutoff_debye, 0, true, inf,
-           "pair cutoff in Debye lengths 1/κ"),
+      physical("electrostatics.charge_e", &Config::electrostatics_charge_e, 0.48, true,
+               "net charge per base pair, e"),
+      physical("electrostatics.dielectric", &Config::electrostatics_dielectric, 77.7, false,
+               "dielectric constant of water εw"),
+      physical("electrostatics.cutoff_debye", &Config::electrostatics_cutoff_debye, 16, false,
+               "pair cutoff in Debye lengths 1/κ"),
       boolean("steric.enabled", &Config::steric_enabled, "hard-core repulsion between segments"),
-      real("steric.diameter_A", &Config::steric_diameter_A, 0, true, inf,
-           "hard-core diameter D, Å"),
-      real("steric.stiffness", &Config::steric_stiffness_kT_A2, 0, false, inf,
-           "hard-core spring constant g, kT/Å²"),
+      physical("steric.diameter_A", &Config::steric_diameter_A, 20, false,
+               "hard-core diameter D, Å"),
+      physical("steric.stiffness", &Config::steric_stiffness_kT_A2, 0.1, true,
+               "hard-core spring constant g, kT/Å²"),
       integer("output.every_steps", &Config::output_every_steps, 1,
               std::numeric_limits<int64_t>::max(), "steps between diagnostics rows"),
       frame_key(),
@@ -350,7 +378,7 @@ void set_key(Config& c, const std::string& name, const toml::node& n) {
   const Key* k = find_key(name);
   // a sub-key of a table-valued key (rod.perturbation_random.seed): set as a one-entry table
   if (const auto dot = name.rfind('.'); !k && dot != std::string::npos && dot > name.find('.')) {
-    if (const Key* parent = find_key(name.substr(0, dot))) {
+    if (const Key* parent = find_key(name.substr(0, dot)); parent && parent->is_table) {
       toml::table t;
       t.insert(name.substr(dot + 1), n);
       parent->set(c, t);
@@ -360,10 +388,10 @@ void set_key(Config& c, const std::string& name, const toml::node& n) {
   if (!k) {
     const std::string known = known_keys_in(section_of(name));
     if (name.find('.') == std::string::npos || known.empty())
-      throw ConfigError("config: unknown key '" + name + "' (sections are: " + known_sections() +
-                        ")");
-    throw ConfigError("config: unknown key '" + name + "' (keys in [" + section_of(name) +
-                      "]: " + known + ")");
+      throw ConfigError("config: unknown key '" + echo(name) +
+                        "' (sections are: " + known_sections() + ")");
+    throw ConfigError("config: unknown key '" + echo(name) + "' (keys in [" +
+                      echo(section_of(name)) + "]: " + known + ")");
   }
   k->set(c, n);
 }
@@ -381,7 +409,7 @@ void apply_toml(Config& c, const std::string& text, const std::string& source) {
     const std::string s(sec.str());
     const toml::table* t = node.as_table();
     if (!t)
-      throw ConfigError("config: top-level key '" + s + "' must be a section [" + s +
+      throw ConfigError("config: top-level key '" + echo(s) + "' must be a section [" + echo(s) +
                         "] (sections are: " + known_sections() + ")");
     for (auto&& [key, value] : *t) set_key(c, s + "." + std::string(key.str()), value);
   }
@@ -399,16 +427,22 @@ Config load_config(const std::string& path) {
 void apply_override(Config& c, const std::string& assignment) {
   const auto eq = assignment.find('=');
   if (eq == std::string::npos || eq == 0)
-    throw ConfigError("config: --set '" + assignment + "' must have the form section.key=value");
+    throw ConfigError("config: --set '" + echo(assignment) +
+                      "' must have the form section.key=value");
   std::string key = assignment.substr(0, eq), value = assignment.substr(eq + 1);
   while (!key.empty() && key.back() == ' ') key.pop_back();
+  // One line, one value: a newline would let TOML read (and this function drop) a second key.
+  for (const char ch : assignment)
+    if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f)
+      throw ConfigError("config: --set " + echo(key) + "=" + echo(value) +
+                        ": control characters (newline, tab, …) are not allowed in --set");
   toml::table t;
   try {
     t = toml::parse("v = " + value, "--set " + key);
   } catch (const toml::parse_error& e) {
-    throw ConfigError("config: --set " + key + "=" + value +
+    throw ConfigError("config: --set " + echo(key) + "=" + echo(value) +
                       ": the value is not a TOML number, boolean, string or array (" +
-                      std::string(e.description()) + ")");
+                      echo(std::string(e.description()), 200) + ")");
   }
   set_key(c, key, *t.get("v"));
 }

@@ -6,6 +6,7 @@
 
 #include <toml++/toml.h>
 
+#include "config/detail.hpp"
 #include "core/error.hpp"
 
 namespace ibrod::config {
@@ -14,7 +15,8 @@ inline ConfigError toml_syntax_error(const std::string& what, const std::string&
                                      const toml::parse_error& e) {
   std::ostringstream os;
   os << what << ": " << source << ":" << e.source().begin.line << ":"
-     << e.source().begin.column << ": TOML syntax error: " << e.description();
+     << e.source().begin.column << ": TOML syntax error: "
+     << detail::echo(std::string(e.description()), 200);
   return ConfigError(os.str());
 }
 

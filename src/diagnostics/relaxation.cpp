@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace ibrod::diag {
+namespace ibrod::diagnostics {
 
 namespace {
 
@@ -212,4 +212,4 @@ std::vector<Transient> transients(std::span<const double> t, std::span<const dou
   return out;
 }
 
-}  // namespace ibrod::diag
+}  // namespace ibrod::diagnostics

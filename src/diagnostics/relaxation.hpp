@@ -9,7 +9,7 @@
 #include <span>
 #include <vector>
 
-namespace ibrod::diag {
+namespace ibrod::diagnostics {
 
 /// Ordinary least-squares line y ≈ intercept + slope·x over the window [first, first + count) of
 /// the caller's series.
@@ -101,4 +101,4 @@ struct Transient {
 std::vector<Transient> transients(std::span<const double> t, std::span<const double> kinetic,
                                   std::span<const double> total, const TransientOptions& opt = {});
 
-}  // namespace ibrod::diag
+}  // namespace ibrod::diagnostics

@@ -22,7 +22,7 @@
 #include <stdexcept>
 #include <vector>
 
-namespace ibrod::diag {
+namespace ibrod::diagnostics {
 
 namespace {
 
@@ -126,7 +126,7 @@ double linking_number(std::span<const Vec3> A, std::span<const Vec3> B) {
 // Indiana Univ. Math. J. 25 (1976) 1171, for polygons).
 double twist(std::span<const Vec3> X, std::span<const Vec3> d1) {
   const int n = int(X.size());
-  if (int(d1.size()) != n) throw std::invalid_argument("diag::twist: X and d1 differ in length");
+  if (int(d1.size()) != n) throw std::invalid_argument("diagnostics::twist: X and d1 differ in length");
   if (n < 3) return 0.0;
   std::vector<Vec3> t(n);
   for (int k = 0; k < n; ++k) t[k] = (X[(k + 1) % n] - X[k]).normalized();
@@ -190,4 +190,4 @@ double mean_spacing(std::span<const Vec3> X) {
   return sum / n;
 }
 
-}  // namespace ibrod::diag
+}  // namespace ibrod::diagnostics

@@ -5,7 +5,7 @@
 
 #include "core/types.hpp"
 
-namespace ibrod::diag {
+namespace ibrod::diagnostics {
 
 /// Writhe of the closed polygon X_0 … X_{n−1} (X_n = X_0), exact for polygons (the Gauss double
 /// integral as a sum of signed solid angles of segment pairs): Wr = (1/2π) Σ_{i<j, not adjacent}
@@ -58,4 +58,4 @@ struct ClosestPair {
 /// with no admissible pair (n < 2·min_separation) returns {+∞, −1, −1}. O(n²).
 ClosestPair closest_pair(std::span<const Vec3> X, int min_separation);
 
-}  // namespace ibrod::diag
+}  // namespace ibrod::diagnostics

@@ -11,7 +11,10 @@
 #include <stdexcept>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "core/error.hpp"
+#include "core/text_file.hpp"
 #include "driver/mpi_env.hpp"
 #include "driver/progress.hpp"
 #include "driver/run_files.hpp"
@@ -24,6 +27,7 @@
 #include "io/npy.hpp"
 #include "io/run_dir.hpp"
 #include "sim/rod_problem.hpp"
+#include "sim/stability.hpp"
 
 namespace ibrod::driver {
 
@@ -68,9 +72,15 @@ struct Run::State {
   Clock::time_point t0 = Clock::now();
   bool distributed = false;
   Progress progress;
+  std::optional<DirLock> lock;               // rank 0: held while the run writes dir
 
   std::optional<io::Checkpoint> checkpoint;  // the one to continue from, until it is applied
   bool config_changed = false;
+  bool extension = false;  // --resume with a later time.t_end_us alone
+  // a run that stopped but was killed before its final files were all written: --resume only
+  // writes them (the reason it stopped, from the checkpoint)
+  bool complete_only = false;
+  StopReason stopped_reason = StopReason::none;
   std::optional<sim::Simulation> sim;
   std::unique_ptr<RunFiles> files;           // rank 0 only
   std::vector<double> gathered;              // distributed: the whole velocity on rank 0
@@ -109,15 +119,30 @@ struct Run::State {
   std::string progress_line(const sim::Observables& o) const;
   void write_frame();
   void ensure_space() {
-    on_root([&] { files->ensure_space(reserve_bytes); });
+    on_root([&] { files->ensure_space(reserve_bytes, result.checkpoint_step >= 0); });
   }
   void write_checkpoint(StopReason reason);
   void finish(const sim::Observables& o, const std::string& stop_reason, const std::string& error);
   [[noreturn]] void blow_up(const std::string& what);
   sim::Observables observe_checked();
   void check_link(const sim::Observables& o);
+  StopReason test_stability(StopReason candidate);
+  bool final_files_complete(const std::string& stop_reason) const;
+  RunResult complete();
   RunResult loop(const SignalGuard& signals);
 };
+
+// Whether every final file of a run that stopped for `stop_reason` is there: summary.json with
+// that stop_reason, final_state.csv, velocity.npy if asked for.
+bool Run::State::final_files_complete(const std::string& stop_reason) const {
+  const auto summary = try_read_text_file(dir.summary());
+  if (!summary || summary->find("\"stop_reason\": \"" + stop_reason + "\"") == std::string::npos)
+    return false;
+  std::error_code ec;
+  if (!fs::exists(dir.final_state(), ec)) return false;
+  if (c.output_fluid_velocity && !fs::exists(dir.velocity(), ec)) return false;
+  return true;
+}
 
 void Run::State::check_launch() const {
   if (distributed && c.grid_n % opt.ranks != 0)
@@ -135,6 +160,8 @@ void Run::State::check_launch() const {
 void Run::State::open_checkpoint() {
   const fs::path cp = dir.checkpoint();
   std::error_code ec;
+  // one writer: the lock before the checkpoint is read (a run still writing it is refused)
+  if (fs::is_directory(dir.root(), ec)) on_root([&] { lock.emplace(dir.root()); });
   if (!fs::exists(cp, ec))
     throw ConfigError("resume: " + cp.string() +
                       " does not exist (the run stopped before its first checkpoint, or '" +
@@ -150,14 +177,38 @@ void Run::State::open_checkpoint() {
                       std::to_string(c.rod_base_pairs) + ": incompatible, even with --force");
   const std::string diff = config::config_differences(ck.meta.config_toml, user, cp.string());
   config_changed = !diff.empty();
-  if (config_changed && !opt.force)
+  // a later t_end alone extends the run: the continuation is the uninterrupted longer run
+  extension = config_changed && config::only_end_time_extended(ck.meta.config_toml, user, cp.string());
+  if (extension)
+    say("ibrod: extending the run in " + dir.root().string() + " (" + diff + ")");
+  if (config_changed && !opt.force && !extension)
     throw ConfigError("resume: the configuration differs from the one " + cp.string() +
                       " was written with (" + diff +
                       "); pass --force to continue with the new values (the continued run is "
                       "then not the uninterrupted run of either configuration)");
-  if (config_changed)
+  if (config_changed && !extension)
     say("ibrod: warning: resuming with a changed configuration (--force): " + diff);
-  if (ck.meta.stop_reason != "none" && !config_changed) {
+  // the time is state: a run never goes back (a shorter t_end than the checkpoint's time is an
+  // error, not a run that stops "at step 60/50")
+  const double dt = c.time_dt_ns * 1e-9, t_end = c.time_t_end_us * 1e-6;
+  const double time_ck = ck.meta.time_s >= 0 ? ck.meta.time_s : double(ck.meta.step) * dt;
+  if (t_end < time_ck - 0.5 * dt) {
+    char buf[320];
+    std::snprintf(buf, sizeof buf,
+                  "resume: time.t_end_us = %.6g is before the time of the checkpoint %s "
+                  "(%.6g us, step %lld): a run cannot go back; give a later time.t_end_us",
+                  c.time_t_end_us, cp.c_str(), time_ck / 1e-6,
+                  static_cast<long long>(ck.meta.step));
+    throw ConfigError(buf);
+  }
+  if (ck.meta.stop_reason != "none" && !config_changed && !final_files_complete(ck.meta.stop_reason)) {
+    // killed after its final checkpoint, before its final files: write them now
+    say("ibrod: the run in " + dir.root().string() + " stopped (" + ck.meta.stop_reason +
+        ") at step " + std::to_string(ck.meta.step) + " but its final files are incomplete; "
+        "writing them");
+    complete_only = true;
+    stopped_reason = sim::stop_reason_from(ck.meta.stop_reason);
+  } else if (ck.meta.stop_reason != "none" && !config_changed) {
     say("ibrod: the run in " + dir.root().string() + " already stopped (" +
         ck.meta.stop_reason + ") at step " + std::to_string(ck.meta.step) + "; nothing to do");
     result.already_finished = true;
@@ -177,7 +228,7 @@ void Run::State::prepare_directory() {
     return;
   }
   on_root([&] {
-    prepare_output_dir(dir, opt.overwrite);
+    prepare_output_dir(dir, opt.overwrite, lock);
     io::write_file_atomic(dir.config(), config_text);
   });
 }
@@ -235,7 +286,15 @@ void Run::State::restore_state() {
 
 void Run::State::open_files() {
   on_root([&] {
-    files = std::make_unique<RunFiles>(dir, c, *sim, result.resumed_from, config_text, progress);
+    // extending a run that stopped at its end time: its last row and frame were written because
+    // it stopped, not by the schedule; the uninterrupted longer run has them only if on schedule
+    std::int64_t rows_to = result.resumed_from, frames_to = result.resumed_from;
+    if (extension && result.resumed_from > 0) {
+      const sim::OutputSchedule& out = sim->params().output;
+      if (rows_to % out.rows != 0) --rows_to;
+      if (out.frames > 0 && frames_to % out.frames != 0) --frames_to;
+    }
+    files = std::make_unique<RunFiles>(dir, c, *sim, rows_to, config_text, progress, frames_to);
   });
   // free space kept in hand: a checkpoint (written beside the previous one), a few frames
   // (H5MD + .vtp, ~300 B per point, + the .vti) and 16 MiB of slack
@@ -359,6 +418,46 @@ sim::Observables Run::State::observe_checked() {
   return o;
 }
 
+RunResult Run::State::complete() {
+  loop_start = Clock::now();
+  start_step = sim->step_count();
+  last_row = sim->observe();
+  result.reason = stopped_reason;
+  meta.stop_reason = to_string(stopped_reason);
+  finish(last_row, to_string(stopped_reason), "");
+  return result;
+}
+
+// The kinetic-energy rule fired: test the state before calling it an equilibrium
+// (sim/stability.hpp). Unstable: the run goes on from the probe's end, with a row there.
+StopReason Run::State::test_stability(StopReason candidate) {
+  sim::Simulation& s = *sim;
+  const sim::StabilityProbe& probe = s.params().stability;
+  if (!probe.enabled || distributed) return candidate;
+  nlohmann::json tests = nlohmann::json::parse(meta.stability_tests_json);
+  const sim::ProbeOutcome o = sim::probe_stability(s, probe, tests.size());
+  tests.push_back({{"step", o.step},
+                   {"time_us", o.time_us},
+                   {"probe_steps", o.steps},
+                   {"probe_time_us", double(o.steps) * s.dt() / 1e-6},
+                   {"amplitude_rad", probe.amplitude},
+                   {"seed", probe.seed + tests.size()},
+                   {"E_total_before_kT", o.E_before_kT},
+                   {"E_total_after_kT", o.E_after_kT},
+                   {"writhe_before", o.writhe_before},
+                   {"writhe_after", o.writhe_after},
+                   {"stable", o.stable}});
+  meta.stability_tests_json = tests.dump();
+  say("ibrod: stability test at step " + std::to_string(o.step) + ": " + sim::describe(o) +
+      (o.stable ? "; an equilibrium" : "; not an equilibrium, the run goes on from there"));
+  if (o.stable) return candidate;
+  if (const std::string bad = sim::rod_problem(s.rod(), c.rod_rise_A); !bad.empty()) blow_up(bad);
+  last_row = observe_checked();
+  on_root([&] { files->row(last_row); });
+  check_link(last_row);
+  return s.at_end() ? StopReason::end_time : StopReason::none;
+}
+
 void Run::State::check_link(const sim::Observables& o) {
   const double drift = std::abs(o.link - result.initial.link);
   meta.max_link_drift = std::max(meta.max_link_drift, drift);
@@ -398,7 +497,13 @@ RunResult Run::State::loop(const SignalGuard& signals) {
     }
 
     StopReason reason = StopReason::none;
-    for (;;) {
+    if (s.at_end()) {
+      // resumed at its end time (a checkpoint at t_end, or t_end moved to it): stop here
+      reason = StopReason::end_time;
+      write_checkpoint(reason);
+      progress.update(progress_line(last_row), seconds_since(loop_start), /*last=*/true);
+    }
+    while (reason == StopReason::none) {
       // distributed: the ranks agree on a signal (each may see it after another step)
       if (const int sig = distributed ? int(mpi::max(signals.pending())) : signals.pending()) {
         // the end of the current step: save it, then stop
@@ -421,6 +526,7 @@ RunResult Run::State::loop(const SignalGuard& signals) {
         on_root([&] { files->row(last_row); });
         check_link(last_row);
         reason = s.stop_reason(last_row);
+        if (reason == StopReason::equilibrium) reason = test_stability(reason);
       }
       const bool stop = reason != StopReason::none;
       const bool frame_step = s.frame_due(stop);
@@ -445,14 +551,24 @@ RunResult Run::State::loop(const SignalGuard& signals) {
   } catch (const RunError& e) {
     // leave a summary that says why the run stopped, if the disk still takes one
     const std::string what = e.what();
-    if (what.rfind("run: blow-up", 0) != 0) {
-      try {
-        finish(last_row, to_string(StopReason::error), what);
-      } catch (const RunError&) {
-      }
+    if (what.rfind("run: blow-up", 0) == 0) {
+      progress.finish_line();
+      throw;
+    }
+    try {
+      finish(last_row, to_string(StopReason::error), what);
+    } catch (const RunError&) {
     }
     progress.finish_line();
-    throw;
+    // the advice that works: --resume needs a checkpoint
+    if (what.find("--resume") != std::string::npos || what.find("--overwrite") != std::string::npos)
+      throw;
+    throw RunError(what + (result.checkpoint_step >= 0
+                               ? "; once the cause is fixed, continue with: ibrod run --resume " +
+                                     dir.root().string()
+                               : "; the run stopped before its first checkpoint: once the cause "
+                                 "is fixed, start it again with --overwrite (ibrod run CONFIG -o " +
+                                     dir.root().string() + " --overwrite)"));
   }
 
   char buf[512];
@@ -489,6 +605,7 @@ RunResult Run::execute() {
   st.build_simulation();
   st.restore_state();
   st.open_files();
+  if (st.complete_only) return st.complete();
   st.announce();
   return st.loop(signals);
 }

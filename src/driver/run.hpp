@@ -35,7 +35,7 @@ struct RunOptions {
   bool handle_signals = true; ///< SIGINT/SIGTERM: checkpoint at the end of the step, then return
   std::FILE* log = stdout;    ///< progress lines and warnings (nullptr: silent)
   int tty = -1;               ///< progress style: 1 in place ('\r'), 0 plain lines, −1 isatty(log)
-  /// MPI rank and rank count of MPI_COMM_WORLD (`mpirun -np K ibrod run`, io/mpi_env.hpp): with
+  /// MPI rank and rank count of MPI_COMM_WORLD (`mpirun -np K ibrod run`, driver/mpi_env.hpp): with
   /// ranks > 1 the fluid grid is split over the ranks (fluid::DistributedFluid), every rank runs
   /// the rod and the loop, and rank 0 alone writes files and progress. Every rank must call run().
   int rank = 0;

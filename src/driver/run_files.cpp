@@ -2,31 +2,46 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cstdio>
+#include <cstdlib>
+
 #include "io/observables_json.hpp"
 
 namespace ibrod::driver {
 
 namespace fs = std::filesystem;
 using io::CheckpointMeta;
+
+namespace {
+// The simulated time is a sum of steps: 0.5 µs comes out as 0.5000000000000001. summary.json
+// gives it to 12 significant digits (far below any Δt), so that it reads as the time it is.
+double time_without_noise(double t_us) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.12g", t_us);
+  return std::strtod(buf, nullptr);
+}
+}  // namespace
 using io::observables_json;
 
-void prepare_output_dir(const io::RunDir& run_dir, bool overwrite) {
+void prepare_output_dir(const io::RunDir& run_dir, bool overwrite, std::optional<DirLock>& lock) {
   const fs::path& dir = run_dir.root();
   std::error_code ec;
-  if (fs::exists(dir, ec)) {
-    if (!fs::is_directory(dir, ec))
-      throw ConfigError("output: '" + dir.string() + "' exists and is not a directory");
-    if (!fs::is_empty(dir, ec) && !overwrite)
-      throw ConfigError("output: directory '" + dir.string() +
-                        "' already holds files; choose another -o DIR, pass --overwrite, or "
-                        "continue a stopped run with --resume " + dir.string());
-    if (overwrite) {
-      // stale frames or a stale checkpoint of an earlier run must not mix with this one
-      for (const fs::path& f : run_dir.run_files()) fs::remove_all(f, ec);
-    }
-  }
+  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
+    throw ConfigError("output: '" + dir.string() + "' exists and is not a directory");
   fs::create_directories(dir, ec);
   if (ec) throw RunError("output: cannot create '" + dir.string() + "': " + ec.message());
+  lock.emplace(dir);  // before anything is looked at or removed: one writer at a time
+  bool holds_files = false;
+  for (const auto& e : fs::directory_iterator(dir, ec))
+    if (e.path() != run_dir.lock()) holds_files = true;
+  if (holds_files && !overwrite)
+    throw ConfigError("output: directory '" + dir.string() +
+                      "' already holds files; choose another -o DIR, pass --overwrite, or "
+                      "continue a stopped run with --resume " + dir.string());
+  if (overwrite) {
+    // stale frames or a stale checkpoint of an earlier run must not mix with this one
+    for (const fs::path& f : run_dir.run_files()) fs::remove_all(f, ec);
+  }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -37,7 +52,7 @@ std::string summary_json(const config::Config& c, const RunResult& r, const Chec
                          const std::string& error) {
   nlohmann::ordered_json j;
   j["steps"] = r.steps;
-  j["time_us"] = r.time_us;
+  j["time_us"] = time_without_noise(r.time_us);
   j["stop_reason"] = stop_reason;
   j["excess_link"] = c.rod_excess_link;
   j["link_drift"] = r.final.link - r.initial.link;
@@ -56,9 +71,20 @@ std::string summary_json(const config::Config& c, const RunResult& r, const Chec
   j["checkpoint_step"] = r.checkpoint_step >= 0 ? nlohmann::ordered_json(r.checkpoint_step)
                                                 : nlohmann::ordered_json(nullptr);
   j["frames"] = frames;
+  j["stability_tests"] = nlohmann::ordered_json::parse(meta.stability_tests_json);
+  // an equilibrium is verified when the last stability test at the stop found it stable
+  if (stop_reason == "equilibrium") {
+    const auto tests = nlohmann::json::parse(meta.stability_tests_json);
+    j["equilibrium_verified"] = !tests.empty() && tests.back().value("stable", false) &&
+                                tests.back().value("step", std::int64_t(-1)) == r.steps;
+  } else {
+    j["equilibrium_verified"] = false;
+  }
   j["error"] = error.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(error);
   j["initial"] = observables_json(r.initial);
   j["final"] = observables_json(r.final);
+  j["initial"]["time_us"] = time_without_noise(r.initial.time_us);
+  j["final"]["time_us"] = time_without_noise(r.final.time_us);
   return j.dump(2) + "\n";
 }
 

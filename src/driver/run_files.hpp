@@ -6,11 +6,13 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "config/config.hpp"
 #include "core/error.hpp"
 #include "core/text_file.hpp"
+#include "driver/dir_lock.hpp"
 #include "driver/progress.hpp"
 #include "driver/run.hpp"
 #include "io/atomic_file.hpp"
@@ -24,10 +26,11 @@
 
 namespace ibrod::driver {
 
-/// Makes the output directory of a fresh run: refuses a non-directory or (without overwrite) a
-/// directory that holds files; with overwrite removes every file an earlier run left
-/// (RunDir::run_files), so that stale frames or checkpoints never mix with the new run.
-void prepare_output_dir(const io::RunDir& dir, bool overwrite);
+/// Makes the output directory of a fresh run and takes its lock (into `lock`; ConfigError if
+/// another process writes it): refuses a non-directory or (without overwrite) a directory that
+/// holds files; with overwrite removes every file an earlier run left (RunDir::run_files), so
+/// that stale frames or checkpoints never mix with the new run.
+void prepare_output_dir(const io::RunDir& dir, bool overwrite, std::optional<DirLock>& lock);
 
 /// summary.json of a run that stopped (stop_reason) or failed (error non-empty).
 std::string summary_json(const config::Config& c, const RunResult& r,
@@ -38,9 +41,10 @@ std::string summary_json(const config::Config& c, const RunResult& r,
 class RunFiles {
  public:
   // resume_step < 0: a fresh run (create everything); otherwise continue the files, dropping
-  // rows and frames after resume_step.
+  // rows after resume_step and frames after frame_step (−1: resume_step).
   RunFiles(const io::RunDir& dir, const config::Config& c, const sim::Simulation& sim,
-           std::int64_t resume_step, const std::string& config_text, Progress& progress)
+           std::int64_t resume_step, const std::string& config_text, Progress& progress,
+           std::int64_t frame_step = -1)
       : dir_(dir),
         ds_(c.rod_rise_A),
         vti_(c.output_fluid_vti),
@@ -56,10 +60,11 @@ class RunFiles {
     } else {
       io::write_file_atomic(ts, io::timeseries_up_to(try_read_text_file(ts).value_or(""),
                                              io::timeseries_header(), resume_step, ts.string()));
-      if (frames_on_) reopen_trajectory(dir.trajectory(), n, c.grid_box_A, resume_step,
+      if (frame_step < 0) frame_step = resume_step;
+      if (frames_on_) reopen_trajectory(dir.trajectory(), n, c.grid_box_A, frame_step,
                                         config_text, progress);
-      if (frames_on_) rod_pvd_.resume(resume_step);
-      if (frames_on_ && vti_) fluid_pvd_.resume(resume_step);
+      if (frames_on_) rod_pvd_.resume(frame_step);
+      if (frames_on_ && vti_) fluid_pvd_.resume(frame_step);
     }
     ts_ = std::fopen(ts.c_str(), "a");
     if (!ts_) throw RunError("output: cannot open " + ts.string() + ": " + io::io_error_text(errno));
@@ -73,14 +78,18 @@ class RunFiles {
   /// Throws RunError if the device of the output directory has less than `bytes` free: a full
   /// disk is better met before a write than in the middle of one (HDF5 cannot always recover a
   /// file whose write failed half-way).
-  void ensure_space(std::uintmax_t bytes) const {
+  /// has_checkpoint: the run has written a checkpoint, so `--resume` can continue it (otherwise
+  /// the advice is to start it again with --overwrite).
+  void ensure_space(std::uintmax_t bytes, bool has_checkpoint) const {
     std::error_code ec;
     const std::filesystem::space_info space = std::filesystem::space(dir_.root(), ec);
     if (!ec && space.available < bytes)
       throw RunError("output: only " + std::to_string(space.available >> 20) + " MiB left on the "
                      "device of " + dir_.root().string() + " (disk full?); stopped before writing, so "
-                     "every file is intact: free space and continue with --resume " +
-                     dir_.root().string());
+                     "every file is intact: free space and " +
+                     (has_checkpoint ? "continue with --resume " + dir_.root().string()
+                                     : "start the run again with --overwrite (it stopped before "
+                                       "its first checkpoint)"));
   }
 
   void row(const sim::Observables& o) {
@@ -118,7 +127,7 @@ class RunFiles {
       return;
     }
     try {
-      h5_ = io::H5mdWriter::reopen(path, n, last, config_text);
+      h5_ = io::H5mdWriter::reopen(path, n, box_A, last, config_text);
     } catch (const RunError& e) {
       // a run killed in the middle of an HDF5 write can leave the file unreadable: keep it for
       // inspection and start a new one, rather than refuse to resume

@@ -20,6 +20,7 @@
 
 #include "core/error.hpp"
 #include "core/text_file.hpp"
+#include "driver/dir_lock.hpp"
 #include "driver/signals.hpp"
 #include "io/atomic_file.hpp"
 #include "io/run_dir.hpp"
@@ -38,6 +39,7 @@ const char* to_string(PointState s) {
     case PointState::interrupted: return "interrupted";
     case PointState::finished: return "finished";
     case PointState::failed: return "failed";
+    case PointState::running: return "running";
   }
   return "?";
 }
@@ -61,6 +63,7 @@ std::string summary_stop_reason(const fs::path& dir) {
 PointState point_state(const fs::path& dir) {
   std::error_code ec;
   if (!fs::exists(dir, ec) || fs::is_empty(dir, ec)) return PointState::fresh;
+  if (dir_lock_holder(dir)) return PointState::running;
   const std::string reason = summary_stop_reason(dir);
   if (reason == "end_time" || reason == "equilibrium") return PointState::finished;
   if (reason == "blow_up") return PointState::failed;
@@ -138,7 +141,15 @@ SweepReport run_sweep(const Sweep& sw, const SweepOptions& opt) {
   fs::create_directories(sweep_dir.configs(), ec);
   fs::create_directories(sweep_dir.logs(), ec);
   if (ec) throw RunError("sweep: cannot create '" + sweep_dir.logs().string() + "': " + ec.message());
-  if (opt.rank == 0) write_file_atomic(sweep_dir.points(), points_csv(sw));
+  if (opt.only_point < 0) {
+    if (opt.rank == 0) write_file_atomic(sweep_dir.points(), points_csv(sw));
+  } else if (!fs::exists(sweep_dir.points(), ec)) {
+    // the tasks of a job array start together: whichever writes it, it is the same file
+    try {
+      write_file_atomic(sweep_dir.points(), points_csv(sw));
+    } catch (const RunError&) {
+    }
+  }
   const std::string binary = opt.binary.empty() ? self_exe() : opt.binary;
   const int jobs = std::max(1, opt.jobs);
   const int ranks = std::max(1, opt.ranks);
@@ -161,11 +172,22 @@ SweepReport run_sweep(const Sweep& sw, const SweepOptions& opt) {
   };
   std::vector<Todo> todo;
   for (const SweepPoint& pt : sw.points) {
-    if (int(pt.index % std::size_t(ranks)) != opt.rank) continue;
+    if (opt.only_point >= 0 ? pt.index != std::size_t(opt.only_point)
+                            : int(pt.index % std::size_t(ranks)) != opt.rank)
+      continue;
     ++rep.points;
     const fs::path dir = sweep_dir.run(pt.name);
     const std::string config_text = to_toml(pt.config);
     const PointState st = point_state(dir);
+    if (st == PointState::running) {
+      // another process writes it (e.g. the orphaned run of a sweep that was killed): one writer
+      ++rep.running;
+      const auto holder = dir_lock_holder(dir);
+      say(tag + pt.name + ": running in another process" +
+          (holder && *holder > 0 ? " (PID " + std::to_string(*holder) + ")" : std::string()) +
+          "; not started again");
+      continue;
+    }
     if (st == PointState::finished || st == PointState::interrupted) {
       // a directory of an earlier, different sweep: never resume or count it as this point
       if (try_read_text_file(RunDir(dir).config()).value_or("") != config_text) {
@@ -267,7 +289,9 @@ SweepReport run_sweep(const Sweep& sw, const SweepOptions& opt) {
   }
   say(tag + "done: " + std::to_string(rep.completed) + " finished now, " +
       std::to_string(rep.skipped) + " already finished, " + std::to_string(rep.failed) +
-      " failed" + (rep.signal ? ", stopped by a signal" : ""));
+      " failed" +
+      (rep.running ? ", " + std::to_string(rep.running) + " still running elsewhere" : "") +
+      (rep.signal ? ", stopped by a signal" : ""));
   return rep;
 }
 

@@ -33,6 +33,7 @@ enum class PointState {
   interrupted,  ///< a checkpoint and no final summary: `ibrod run --resume`
   finished,     ///< summary.json says end_time or equilibrium: skip
   failed,       ///< summary.json says blow_up: not run again (delete the directory to retry)
+  running,      ///< another process holds the directory's lock (driver/dir_lock.hpp): not started
 };
 PointState point_state(const std::filesystem::path& dir);
 const char* to_string(PointState s);
@@ -42,6 +43,7 @@ struct SweepOptions {
   int jobs = 1;                       ///< `ibrod run` processes at a time (per rank)
   std::string binary;                 ///< the ibrod to spawn ("": /proc/self/exe)
   int rank = 0, ranks = 1;            ///< this rank runs points with index % ranks == rank
+  long only_point = -1;               ///< ≥ 0: run this point alone (a job array's task)
   bool handle_signals = true;         ///< SIGINT/SIGTERM: pass on to the runs, wait, return
   std::FILE* log = stdout;            ///< progress lines (nullptr: silent)
 };
@@ -53,6 +55,7 @@ struct SweepReport {
   int resumed = 0;      ///< continued from a checkpoint
   int completed = 0;    ///< finished by this invocation
   int failed = 0;       ///< failed now or before (blow-up), or stale
+  int running = 0;      ///< written by another process (its lock is held): not started
   int signal = 0;       ///< SIGINT/SIGTERM that stopped the sweep (0: none)
   std::vector<std::string> failed_names;
 };

@@ -94,7 +94,7 @@ struct ElectroParams {
   double cutoff = 0;  ///< pairs farther apart than this (Å) are dropped; <= 0: no cutoff
 };
 
-/// ElectroParams from the config's natural parameters (io/config.cpp): the law of
+/// ElectroParams from the config's natural parameters (config/params.cpp): the law of
 /// debye_huckel(charge_e, dielectric, salt_M) and the cutoff rc = cutoff_debye / κ Å, in Debye
 /// lengths (kDefaultCutoffDebye by default); no cutoff (0) when κ = 0 (no salt).
 ElectroParams electro_params(bool enabled, double charge_e, double dielectric, double salt_M,

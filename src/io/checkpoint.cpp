@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.hpp"
+#include "core/text_file.hpp"
 #include "io/atomic_file.hpp"
 #include "io/observables.hpp"
 #include "io/observables_json.hpp"
@@ -66,6 +67,7 @@ std::string meta_json(const CheckpointMeta& m) {
   j["resumes"] = m.resumes;
   j["implicit_next_dt_s"] = m.implicit_next_dt_s;
   j["implicit_accepted_in_a_row"] = m.implicit_accepted_in_a_row;
+  j["stability_tests"] = nlohmann::json::parse(m.stability_tests_json);
   j["initial"] = observables_json(m.initial);
   j["config_toml"] = m.config_toml;
   return j.dump();  // doubles with 17 significant digits: they read back exactly
@@ -89,6 +91,7 @@ CheckpointMeta meta_from(const std::string& text) {
     m.implicit_next_dt_s = j.at("implicit_next_dt_s").get<double>();
     m.implicit_accepted_in_a_row = j.at("implicit_accepted_in_a_row").get<int>();
   }
+  m.stability_tests_json = j.contains("stability_tests") ? j.at("stability_tests").dump() : "[]";
   m.initial = observables_from(j.at("initial"));
   m.config_toml = j.at("config_toml").get<std::string>();
   return m;
@@ -168,6 +171,8 @@ void write_checkpoint(const std::filesystem::path& path, const CheckpointMeta& m
 
 Checkpoint read_checkpoint(const std::filesystem::path& path) {
   const std::string name = path.string();
+  if (const std::string why = unreadable_reason(path); !why.empty())
+    throw ConfigError("checkpoint " + name + " cannot be read: " + why);
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) throw ConfigError("checkpoint " + name + " cannot be read (missing or no permission)");
   const std::streamoff size = in.tellg();

@@ -45,6 +45,9 @@ struct CheckpointMeta {
   /// accepted steps (sim::Simulation::implicit_state)
   double implicit_next_dt_s = -1;
   int implicit_accepted_in_a_row = 0;
+  /// the stability tests so far (sim/stability.hpp), a JSON array of objects as summary.json
+  /// lists them
+  std::string stability_tests_json = "[]";
 };
 
 struct Checkpoint {

@@ -19,6 +19,18 @@
 namespace ibrod::io {
 namespace {
 
+// Units as H5MD readers know them (MDAnalysis, h5py users): ASCII, time in ns, lengths in Å.
+constexpr const char* kTimeUnit = "ns";
+constexpr const char* kLengthUnit = "Angstrom";
+
+// The unit attribute of an observable's values, from its column name ("" none: dimensionless).
+const char* observable_unit(const std::string& name) {
+  if (name.size() > 3 && name.compare(name.size() - 3, 3, "_kT") == 0) return "kT";
+  if (name.size() > 2 && name.compare(name.size() - 2, 2, "_A") == 0) return kLengthUnit;
+  return nullptr;
+}
+
+
 // HDF5 prints its error stack to stderr by default; ibrod reports errors itself (hdf5_error).
 // No atexit clean-up either: HDF5 1.10 crashes at exit closing a file whose flush failed (a full
 // disk); every file ibrod opens is closed by its owner (Hid) anyway.
@@ -119,6 +131,28 @@ void string_attribute(const Context& cx, hid_t obj, const char* name,
   if (H5Awrite(a, type, ptrs.data()) < 0) cx.fail(std::string("write attribute ") + name);
 }
 
+// A scalar string attribute ("" if absent or not a string).
+std::string read_string_attribute(hid_t obj, const char* name) {
+  if (H5Aexists(obj, name) <= 0) return "";
+  Hid a(H5Aopen(obj, name, H5P_DEFAULT), H5Aclose);
+  if (a < 0) return "";
+  Hid type(H5Aget_type(a), H5Tclose);
+  if (H5Tget_class(type) != H5T_STRING) return "";
+  std::string out;
+  if (H5Tis_variable_str(type) > 0) {
+    Hid mem = utf8_string_type();
+    char* p = nullptr;
+    if (H5Aread(a, mem, &p) >= 0 && p) {
+      out = p;
+      H5free_memory(p);
+    }
+  } else {
+    std::string buf(H5Tget_size(type), '\0');
+    if (H5Aread(a, type, buf.data()) >= 0) out = buf.c_str();
+  }
+  return out;
+}
+
 void int_attribute(const Context& cx, hid_t obj, const char* name, const std::vector<int>& values,
                    bool scalar) {
   const hsize_t dims[1] = {values.size()};
@@ -209,6 +243,8 @@ struct H5mdWriter::Impl {
   Context cx;
   Hid file;
   std::array<Series, 4> rod;          // kElements
+  Series box;                         // box/edges, one record per frame
+  double box_A = 0;
   std::vector<Series> observables;    // observable_fields()
   std::vector<double> buf;            // one frame of one element, [n × 3]
   int n = 0;
@@ -224,7 +260,7 @@ struct H5mdWriter::Impl {
     s.inner = inner;
     s.step = extendible(cx, s.group, "step", H5T_STD_I64LE, {}, kChunk1);
     s.time = extendible(cx, s.group, "time", H5T_IEEE_F64LE, {}, kChunk1);
-    string_attribute(cx, s.time, "unit", {"µs"}, true);
+    string_attribute(cx, s.time, "unit", {kTimeUnit}, true);
     s.value = extendible(cx, s.group, "value", H5T_IEEE_F64LE, inner, inner.empty() ? kChunk1 : 1);
     if (unit) string_attribute(cx, s.value, "unit", {unit}, true);
     return s;
@@ -238,6 +274,9 @@ struct H5mdWriter::Impl {
     s.step = cx.dataset(s.group, "step");
     s.time = cx.dataset(s.group, "time");
     s.value = cx.dataset(s.group, "value");
+    if (read_string_attribute(s.time, "unit") != kTimeUnit)
+      throw RunError("trajectory " + cx.file + ": /" + name +
+                     "/time is not in " + kTimeUnit + " (written by an older ibrod)");
     std::vector<hsize_t> want{0};
     want.insert(want.end(), inner.begin(), inner.end());
     std::vector<hsize_t> got = shape(cx, s.value);
@@ -261,8 +300,9 @@ struct H5mdWriter::Impl {
   }
 
   void append(Series& s, std::int64_t step, double time_us, const void* value) {
+    const double time_ns = time_us * 1e3;
     append_record(cx, s.step, H5T_NATIVE_INT64, &step, {}, "step");
-    append_record(cx, s.time, H5T_NATIVE_DOUBLE, &time_us, {}, "time");
+    append_record(cx, s.time, H5T_NATIVE_DOUBLE, &time_ns, {}, "time");
     append_record(cx, s.value, H5T_NATIVE_DOUBLE, value, s.inner, "value");
   }
 
@@ -330,22 +370,17 @@ std::unique_ptr<H5mdWriter> H5mdWriter::create(const std::filesystem::path& path
     Hid box = cx.group(rod, "box", true);
     int_attribute(cx, box, "dimension", {3}, true);
     string_attribute(cx, box, "boundary", {"periodic", "periodic", "periodic"}, false);
-    const hsize_t three[1] = {3};
-    Hid space(H5Screate_simple(1, three, nullptr), H5Sclose);
-    Hid edges(cx.ok(H5Dcreate2(box, "edges", H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT,
-                               H5P_DEFAULT),
-                    "create box/edges"),
-              H5Dclose);
-    const double e[3] = {box_A, box_A, box_A};
-    if (H5Dwrite(edges, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, e) < 0)
-      cx.fail("write box/edges");
-    string_attribute(cx, edges, "unit", {"Å"}, true);
+    // time-dependent (step, time, value [T, 3]) although the box never changes: H5MD allows a
+    // fixed dataset, but MDAnalysis's H5MD reader reads box/edges/value per frame
+    m.box = Impl::make(cx, box, "edges", {3}, kLengthUnit);
+    m.box_A = box_A;
     for (int e2 = 0; e2 < 4; ++e2)
-      m.rod[e2] = Impl::make(cx, rod, kElements[e2], {hsize_t(n), 3}, e2 == 0 ? "Å" : nullptr);
+      m.rod[e2] = Impl::make(cx, rod, kElements[e2], {hsize_t(n), 3}, e2 == 0 ? kLengthUnit : nullptr);
   }
   {
     Hid obs = cx.group(m.file, "observables", true);
-    for (const auto& f : observable_fields()) m.observables.push_back(Impl::make(cx, obs, f.name, {}, nullptr));
+    for (const auto& f : observable_fields())
+      m.observables.push_back(Impl::make(cx, obs, f.name, {}, observable_unit(f.name)));
   }
   m.set_config(config_toml, true);
   m.flush();
@@ -353,7 +388,7 @@ std::unique_ptr<H5mdWriter> H5mdWriter::create(const std::filesystem::path& path
 }
 
 std::unique_ptr<H5mdWriter> H5mdWriter::reopen(const std::filesystem::path& path, int n,
-                                               std::int64_t last_step,
+                                               double box_A, std::int64_t last_step,
                                                const std::string& config_toml) {
   quiet_hdf5();
   std::unique_ptr<H5mdWriter> w(new H5mdWriter);
@@ -372,6 +407,10 @@ std::unique_ptr<H5mdWriter> H5mdWriter::reopen(const std::filesystem::path& path
       const hsize_t kept = Impl::truncate(cx, m.rod[e], last_step);
       if (e == 0) w->frames_ = std::int64_t(kept);
     }
+    Hid box = cx.group(rod, "box", false);
+    m.box = Impl::open(cx, box, "edges", {3});
+    Impl::truncate(cx, m.box, last_step);
+    m.box_A = box_A;
   }
   {
     Hid obs = cx.group(m.file, "observables", false);
@@ -397,6 +436,8 @@ void H5mdWriter::write_frame(std::int64_t step, double time_us, const rod::RodSt
         m.buf[3 * std::size_t(k) + i] = e == 0 ? s.X[k][i] : s.D[k](i, e - 1);
     m.append(m.rod[e], step, time_us, m.buf.data());
   }
+  const double edges[3] = {m.box_A, m.box_A, m.box_A};
+  m.append(m.box, step, time_us, edges);
   m.flush();
   ++frames_;
 }
@@ -424,6 +465,12 @@ H5mdSeries read_h5md_series(const std::filesystem::path& path, const std::string
   if (!s.time_us.empty() &&
       H5Dread(time, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, s.time_us.data()) < 0)
     cx.fail("read time");
+  // ns since ibrod wrote H5MD units that MDAnalysis reads; µs before
+  const std::string unit = read_string_attribute(time, "unit");
+  if (unit == kTimeUnit)
+    for (double& t : s.time_us) t *= 1e-3;
+  else if (unit != "µs")
+    throw RunError("trajectory " + cx.file + ": time unit '" + unit + "' (expected ns or µs)");
   const std::vector<hsize_t> dims = shape(cx, value);
   if (dims.size() != 3 || dims[2] != 3) throw RunError("trajectory " + cx.file + ": bad value shape");
   s.n = int(dims[1]);

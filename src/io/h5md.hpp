@@ -38,7 +38,7 @@ class H5mdWriter {
   /// dropped, and /parameters/config_toml is set to config_toml. Throws RunError if the file
   /// cannot be opened or does not have the layout for n points.
   static std::unique_ptr<H5mdWriter> reopen(const std::filesystem::path& path, int n,
-                                            std::int64_t last_step,
+                                            double box_A, std::int64_t last_step,
                                             const std::string& config_toml);
   ~H5mdWriter();
   H5mdWriter(const H5mdWriter&) = delete;

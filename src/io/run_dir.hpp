@@ -11,6 +11,7 @@
 //   summary.json       steps, simulated time, why it stopped, link drift, observables, timing
 //   velocity.npy       the final fluid velocity (output.fluid_velocity; io/npy.hpp)
 //   render/            pictures of `ibrod render`
+//   ibrod.lock         the writer's lock: the PID of the process writing the directory
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -37,6 +38,8 @@ class RunDir {
   std::filesystem::path summary() const { return root_ / "summary.json"; }
   std::filesystem::path velocity() const { return root_ / "velocity.npy"; }
   std::filesystem::path render_dir() const { return root_ / "render"; }
+  /// held (flock) by the one process that writes the directory (driver/dir_lock.hpp)
+  std::filesystem::path lock() const { return root_ / "ibrod.lock"; }
   /// the ParaView series: "<prefix>.pvd" and vtk/<prefix>_<step>.<ext>
   static constexpr const char* kRodSeries = "rod";
   static constexpr const char* kFluidSeries = "fluid";

@@ -170,7 +170,7 @@ void PvdSeries::write_pvd() const {
       "  <Collection>\n";
   char buf[256];
   for (const Entry& e : entries_) {
-    std::snprintf(buf, sizeof buf, "    <DataSet timestep=\"%.17g\" group=\"\" part=\"0\" file=\"%s\"/>\n",
+    std::snprintf(buf, sizeof buf, "    <DataSet timestep=\"%.12g\" group=\"\" part=\"0\" file=\"%s\"/>\n",
                   e.time_us, e.file.c_str());
     out += buf;
   }

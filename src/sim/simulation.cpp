@@ -77,8 +77,10 @@ Simulation::Simulation(const SimParams& p)
 
 void Simulation::step() {
   if (implicit_) {
-    // the last step lands on t_end
-    time_ += implicit_->advance(rod_, std::max(p_.t_end - time_, p_.adaptive.dt_min));
+    // the last step lands on t_end (a stability probe may step beyond it: no cap there)
+    const double left = p_.t_end - time_;
+    const double cap = left > 0 ? std::max(left, p_.adaptive.dt_min) : HUGE_VAL;
+    time_ += implicit_->advance(rod_, cap);
     ++step_;
     return;
   }
@@ -109,11 +111,11 @@ Observables Simulation::observe() {
   const int n = rod_.size();
   std::vector<Vec3> d1(n);
   for (int k = 0; k < n; ++k) d1[k] = rod_.D[k].col(0);
-  o.writhe = diag::writhe(rod_.X);
-  o.twist = diag::twist(rod_.X, d1);
+  o.writhe = diagnostics::writhe(rod_.X);
+  o.twist = diagnostics::twist(rod_.X, d1);
   o.link = o.writhe + o.twist;
-  o.closest_approach_A = diag::closest_approach(rod_.X, p_.closest_min_separation);
-  o.bp_spacing_A = diag::mean_spacing(rod_.X);
+  o.closest_approach_A = diagnostics::closest_approach(rod_.X, p_.closest_min_separation);
+  o.bp_spacing_A = diagnostics::mean_spacing(rod_.X);
   return o;
 }
 

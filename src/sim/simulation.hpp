@@ -12,6 +12,7 @@
 
 #include "integrate/implicit.hpp"
 #include "integrate/stepper.hpp"
+#include "sim/stability.hpp"
 #include "rod/rod.hpp"
 
 namespace ibrod::sim {
@@ -42,6 +43,7 @@ struct SimParams {
   double dt = 1e-10;            ///< time step Δt, s (implicit: the largest and the first)
   double t_end = 1e-6;          ///< s
   double stop_kinetic = 0;      ///< stop when E_K < this (g Å² s⁻²) at an output step; 0: never
+  StabilityProbe stability;     ///< tests a state the kinetic-energy rule calls an equilibrium
   OutputSchedule output;
   double kT = 414.2;            ///< g Å² s⁻²
   int closest_min_separation = 20;   ///< pairs at least this many points apart (MODEL §6)

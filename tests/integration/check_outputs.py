@@ -8,6 +8,7 @@ Runs IBROD (argv[1]) on a small configuration, then checks
   rod.pvd, vtk/*.vtp, fluid.pvd, vtk/*.vti  with xml.etree: VTKFile type/version/byte_order,
                  one Piece, array sizes against NumberOfPoints/NumberOfLines/extents, component
                  counts, a closed polyline, points equal to the H5MD frames, DataSet files present.
+  trajectory.h5  with MDAnalysis's H5MD reader too (frames, positions, time units);
 Exit status 0 if every check passes; the first failed check is printed.
 Must run with /usr/bin/python3 (numpy and h5py from Debian).
 """
@@ -61,18 +62,21 @@ def check_h5md(d):
     box = f["particles/rod/box"]
     check(int(box.attrs["dimension"]) == 3, "box dimension 3")
     check([str(b) for b in box.attrs["boundary"]] == ["periodic"] * 3, "box boundary periodic")
-    check(np.allclose(box["edges"][()], [BOX] * 3), "box edges")
+    check(np.allclose(box["edges/value"][()], [[BOX] * 3] * len(range(0, STEPS + 1, FRAME_EVERY))),
+          "box edges, one record per frame")
 
     frames = list(range(0, STEPS + 1, FRAME_EVERY))
     for el in ("position", "d1", "d2", "d3"):
         g = f["particles/rod/" + el]
         check(g["step"].dtype == np.int64 and g["time"].dtype == np.float64, el + " step/time types")
         check(list(g["step"][()]) == frames, el + " steps %s" % list(g["step"][()]))
-        check(np.allclose(g["time"][()], np.array(frames) * 1e-4, rtol=1e-12), el + " time in µs")
+        check(np.allclose(g["time"][()], np.array(frames) * 0.1, rtol=1e-12), el + " time in ns")
+        check(g["time"].attrs["unit"] == "ns", el + " time unit ns")
         v = g["value"]
         check(v.dtype == np.float64 and v.shape == (len(frames), N, 3), el + " value shape")
         check(v.chunks is not None and v.maxshape[0] is None, el + " value chunked, extendible")
-    check(f["particles/rod/position/value"].attrs["unit"] == "Å", "position unit Å")
+    check(f["particles/rod/position/value"].attrs["unit"] == "Angstrom", "position unit Angstrom")
+    check(box["edges/value"].attrs["unit"] == "Angstrom", "box edges unit Angstrom")
 
     # triads orthonormal in every frame
     D = np.stack([f["particles/rod/d%d/value" % i][()] for i in (1, 2, 3)], axis=-1)
@@ -95,7 +99,9 @@ def check_h5md(d):
     for c in columns:
         g = f["observables/" + c]
         check(list(g["step"][()]) == list(ts["step"].astype(int)), c + " steps")
-        check(np.allclose(g["time"][()], ts["time_us"], rtol=1e-9), c + " time")
+        check(np.allclose(g["time"][()], ts["time_us"] * 1e3, rtol=1e-9), c + " time (ns)")
+        unit = "kT" if c.endswith("_kT") else "Angstrom" if c.endswith("_A") else None
+        check(g["value"].attrs.get("unit") == unit, c + " unit %s" % unit)
         # the CSV prints 10 to 12 significant digits
         check(np.allclose(g["value"][()], ts[c], rtol=1e-9, atol=1e-12), c + " values")
     rows = list(range(0, STEPS, ROW_EVERY)) + [STEPS]  # and a last row at the end
@@ -103,7 +109,21 @@ def check_h5md(d):
 
     with open(os.path.join(d, "config.toml")) as c:
         check(f["parameters/config_toml"].asstr()[()] == c.read(), "config_toml = config.toml")
-    return f["particles/rod/position/value"][()], f["particles/rod/position/time"][()]
+    # positions (Å) and times in µs, as the .pvd files give them
+    return f["particles/rod/position/value"][()], f["particles/rod/position/time"][()] * 1e-3
+
+
+def check_mdanalysis(d, positions):
+    """MDAnalysis's own H5MD reader opens the trajectory: frames, positions in Å, times in ps."""
+    import MDAnalysis as mda
+    u = mda.Universe.empty(N, trajectory=True)
+    u.load_new(os.path.join(d, "trajectory.h5"), format="H5MD")
+    traj = u.trajectory
+    check(len(traj) == len(positions), "MDAnalysis: %d frames" % len(traj))
+    for ts, x in zip(traj, positions):
+        check(np.allclose(ts.positions, x, rtol=1e-5, atol=1e-3), "MDAnalysis: positions in Å")
+    traj[1]
+    check(abs(traj.ts.time - FRAME_EVERY * 0.1 * 1e3) < 1e-6, "MDAnalysis: time in ps")
 
 
 def check_vtkfile(path, kind):
@@ -184,11 +204,13 @@ def main():
         r = subprocess.run([binary, "run", cfg, "-o", out], capture_output=True, text=True)
         check(r.returncode == 0, "ibrod run failed:\n" + r.stdout + r.stderr)
         positions, times = check_h5md(out)
+        check_mdanalysis(out, positions)
         for path, frame in zip(check_pvd(out, "rod.pvd", ".vtp", times), positions):
             check_vtp(path, frame)
         for path in check_pvd(out, "fluid.pvd", ".vti", times):
             check_vti(path)
-        print("check_outputs: H5MD, %d .vtp and %d .vti files OK" % (len(times), len(times)))
+        print("check_outputs: H5MD (h5py and MDAnalysis), %d .vtp and %d .vti files OK"
+              % (len(times), len(times)))
         return 0
     except AssertionError as e:
         print("check_outputs: FAILED: %s" % e)

@@ -1,7 +1,10 @@
 #pragma once
-// Small configurations for integration tests: a 100-point ring (r0 ≈ 54 Å) in a 200 Å box on a
-// 16³ grid (h = 12.5 Å, close to the reference 11.3 Å), so that a run of a few thousand steps
-// takes seconds.
+// The one small configuration of the integration tests: a 100-point ring (r0 ≈ 54 Å) in a 200 Å
+// box on a 16³ grid (h = 12.5 Å, close to the reference 11.3 Å), so that a run of a few thousand
+// steps takes seconds. Tests that start the real binary write it with config::to_toml after
+// changing what they need.
+#include <string>
+
 #include "config/config.hpp"
 
 namespace ibrod::test {
@@ -19,4 +22,7 @@ inline config::Config small_config(int excess_link) {
   return c;
 }
 
-}  // namespace ibrod::testing
+/// small_config as the TOML document `ibrod run CONFIG` reads.
+inline std::string small_config_toml(const config::Config& c) { return config::to_toml(c); }
+
+}  // namespace ibrod::test

@@ -29,7 +29,7 @@ inline fs::path fresh_dir(const std::string& name) {
   return d;
 }
 
-inline std::string slurp(const fs::path& p) {
+inline std::string read_file(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
   std::stringstream ss;
   ss << in.rdbuf();
@@ -85,7 +85,7 @@ inline Exit wait_for(const Child& c) {
   Exit e;
   if (WIFEXITED(st)) e.code = WEXITSTATUS(st);
   if (WIFSIGNALED(st)) e.signal = WTERMSIG(st);
-  e.output = slurp(c.log);
+  e.output = read_file(c.log);
   return e;
 }
 
@@ -97,7 +97,7 @@ inline Exit run_ibrod(const std::vector<std::string>& args, const fs::path& log,
 
 /// Complete lines in a file (0 if it does not exist).
 inline int lines_in(const fs::path& p) {
-  const std::string s = slurp(p);
+  const std::string s = read_file(p);
   return int(std::count(s.begin(), s.end(), '\n'));
 }
 

@@ -43,7 +43,7 @@ fs::path fresh_dir(const std::string& name) {
   return d;
 }
 
-std::string slurp(const fs::path& p) {
+std::string read_file(const fs::path& p) {
   std::ifstream in(p);
   std::stringstream ss;
   ss << in.rdbuf();
@@ -51,9 +51,9 @@ std::string slurp(const fs::path& p) {
 }
 
 std::string small_config_toml() {
-  return "[grid]\nn = 16\nbox_A = 200\n[rod]\nbase_pairs = 100\nexcess_link = 2\n"
-         "[time]\ndt_ns = 0.1\nt_end_us = 0.05\n[output]\nevery_steps = 100\n"
-         "[run]\nfftw_measure = false\n";
+  ibrod::config::Config c = ibrod::test::small_config(2);
+  c.time_t_end_us = 0.05;
+  return ibrod::test::small_config_toml(c);
 }
 
 }  // namespace
@@ -67,7 +67,7 @@ TEST(Cli, RunWritesEveryOutputFile) {
   EXPECT_THAT(r.output, HasSubstr("ETA"));
   const fs::path out = d / "out";
   // config.toml is the resolved config: every key, including defaults, with our overrides
-  const std::string cfg = slurp(out / "config.toml");
+  const std::string cfg = read_file(out / "config.toml");
   EXPECT_THAT(cfg, HasSubstr("base_pairs = 100"));
   EXPECT_THAT(cfg, HasSubstr("twist_modulus_erg_cm"));
   // timeseries: header and one row per output step (0, 100, 200, 300, 400, 500)
@@ -91,7 +91,7 @@ TEST(Cli, RunWritesEveryOutputFile) {
     EXPECT_EQ(std::count(line.begin(), line.end(), ','), 11);
   }
   EXPECT_EQ(rows, 100);
-  const std::string summary = slurp(out / "summary.json");
+  const std::string summary = read_file(out / "summary.json");
   for (const char* kv : {R"("steps"\s*:\s*500)", R"("stop_reason"\s*:\s*"end_time")",
                          R"("wall_time_s"\s*:\s*[0-9.e+-]+)", R"("ms_per_step"\s*:\s*[0-9.e+-]+)",
                          R"("link"\s*:\s*2\.0000)", R"("link_drift"\s*:)"})
@@ -107,7 +107,7 @@ TEST(Cli, ExistingOutputIsNotOverwrittenWithoutTheFlag) {
   auto r = sh("run " + (d / "in.toml").string() + " -o " + (d / "out").string());
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_THAT(r.output, HasSubstr("--overwrite"));
-  EXPECT_EQ(slurp(d / "out" / "precious.txt"), "keep me");
+  EXPECT_EQ(read_file(d / "out" / "precious.txt"), "keep me");
   fs::remove_all(d);
 }
 
@@ -145,4 +145,11 @@ TEST(Cli, CheckPrintsDerivedQuantities) {
   for (const char* s : {"grid.n = 64", "Debye length 1/κ          = 9.6", "Bjerrum length",
                         "time steps", "memory estimate", "ring radius r0            = 324.68"})
     EXPECT_THAT(r.output, HasSubstr(s));
+}
+
+TEST(Cli, VersionNamesTheVersionCommitBuildAndMpi) {
+  const Result r = sh("--version");
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(std::regex_search(r.output, std::regex(R"(^ibrod \d+\.\d+\.\d+ \(git \w+, \w+ build, MPI (yes|no)\))")))
+      << r.output;
 }

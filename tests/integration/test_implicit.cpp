@@ -49,7 +49,7 @@ double max_distance(const rod::RodState& a, const rod::RodState& b) {
 double link(const rod::RodState& s) {
   std::vector<Vec3> d1(s.size());
   for (int k = 0; k < s.size(); ++k) d1[k] = s.D[k].col(0);
-  return diag::writhe(s.X) + diag::twist(s.X, d1);
+  return diagnostics::writhe(s.X) + diagnostics::twist(s.X, d1);
 }
 
 TEST(Implicit, FirstOrderConvergenceTowardASmallStepExplicitReference) {
@@ -130,12 +130,12 @@ TEST(Implicit, TwentyTimesTheExplicitLimitThroughCollapseAndContact) {
     e_prev = info.energy_after;
     if (steps % 5 == 0) {
       ASSERT_NEAR(link(r.rod), lk0, 1e-3) << "t = " << t;
-      closest = std::min(closest, diag::closest_approach(r.rod.X, 20));
+      closest = std::min(closest, diagnostics::closest_approach(r.rod.X, 20));
     }
   }
   EXPECT_NEAR(link(r.rod), lk0, 1e-3);
   EXPECT_LT(closest, 21.0);  // the strands did touch (D = 20 Å)
-  const double spacing = diag::mean_spacing(r.rod.X);
+  const double spacing = diagnostics::mean_spacing(r.rod.X);
   EXPECT_GT(spacing, 3.3);
   EXPECT_LT(spacing, 3.7);
   // the point of it: a mean step of at least 5× the explicit limit, with steps at the maximum

@@ -27,7 +27,7 @@ std::string implicit_config() {
 
 // column `name` of a CSV time series
 std::vector<double> column(const fs::path& csv, const std::string& name) {
-  std::istringstream in(slurp(csv));
+  std::istringstream in(read_file(csv));
   std::string line;
   std::getline(in, line);
   int idx = -1, i = 0;
@@ -52,8 +52,8 @@ TEST(ImplicitRun, ReachesTheEndWithAnAdaptiveStepAndResumesBitwise) {
   Exit e = run_ibrod({"run", (root / "in.toml").string(), "-o", (root / "A").string()},
                      root / "A.log");
   ASSERT_EQ(e.code, 0) << e.output;
-  EXPECT_THAT(slurp(root / "A" / "summary.json"), HasSubstr("\"stop_reason\": \"end_time\""));
-  EXPECT_THAT(slurp(root / "A" / "config.toml"), HasSubstr("scheme = 'implicit'"));
+  EXPECT_THAT(read_file(root / "A" / "summary.json"), HasSubstr("\"stop_reason\": \"end_time\""));
+  EXPECT_THAT(read_file(root / "A" / "config.toml"), HasSubstr("scheme = 'implicit'"));
 
   const std::vector<double> t = column(root / "A" / "timeseries.csv", "time_us");
   const std::vector<double> lk = column(root / "A" / "timeseries.csv", "link");
@@ -79,7 +79,7 @@ TEST(ImplicitRun, ReachesTheEndWithAnAdaptiveStepAndResumesBitwise) {
   Child c = spawn({"run", (root / "in.toml").string(), "-o", b.string(), "--fftw-wisdom",
                    (root / "A" / "fftw.wisdom").string()},
                   root / "B1.log");
-  ASSERT_TRUE(wait_for_lines(c, b / "timeseries.csv", 1 + 30)) << slurp(root / "B1.log");
+  ASSERT_TRUE(wait_for_lines(c, b / "timeseries.csv", 1 + 30)) << read_file(root / "B1.log");
   ::kill(c.pid, SIGTERM);
   e = wait_for(c);
   ASSERT_EQ(e.code, 128 + SIGTERM) << "the run finished before it could be stopped\n" << e.output;
@@ -87,8 +87,8 @@ TEST(ImplicitRun, ReachesTheEndWithAnAdaptiveStepAndResumesBitwise) {
   EXPECT_GT(ck.meta.implicit_next_dt_s, 0.0);
   e = run_ibrod({"run", "--resume", b.string()}, root / "B2.log");
   ASSERT_EQ(e.code, 0) << e.output;
-  EXPECT_EQ(slurp(root / "A" / "timeseries.csv"), slurp(b / "timeseries.csv"));
-  EXPECT_EQ(slurp(root / "A" / "final_state.csv"), slurp(b / "final_state.csv"));
+  EXPECT_EQ(read_file(root / "A" / "timeseries.csv"), read_file(b / "timeseries.csv"));
+  EXPECT_EQ(read_file(root / "A" / "final_state.csv"), read_file(b / "final_state.csv"));
   if (!HasFailure()) fs::remove_all(root);
 }
 

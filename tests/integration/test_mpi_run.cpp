@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "helpers.hpp"
 #include "run_helpers.hpp"
 
 using namespace ibrod::test;
@@ -22,11 +23,13 @@ namespace {
 // 16³, 200 Å box, 100 points, electrostatics and steric on (the defaults), 100 steps of 0.1 ns,
 // one thread per process.
 std::string tiny_config() {
-  return "[grid]\nn = 16\nbox_A = 200\n[rod]\nbase_pairs = 100\nexcess_link = 2\n"
-         "[electrostatics]\nenabled = true\n[steric]\nenabled = true\n"
-         "[time]\ndt_ns = 0.1\nt_end_us = 0.01\n"
-         "[output]\nevery_steps = 10\nframe_every_steps = 50\ncheckpoint_every_steps = 50\n"
-         "[run]\nthreads = 1\nfftw_measure = false\n";
+  ibrod::config::Config c = ibrod::test::small_config(2);
+  c.time_t_end_us = 0.01;
+  c.output_every_steps = 10;
+  c.output_frame_every_steps = 50;
+  c.output_checkpoint_every_steps = 50;
+  c.run_threads = 1;
+  return ibrod::test::small_config_toml(c);
 }
 
 bool mpi_usable() {
@@ -109,7 +112,7 @@ TEST(MpiRun, TwoRanksShareTheFluidGridAndAgreeWithOneProcess) {
   ASSERT_EQ(one.code, 0) << one.output;
   const int rc = mpirun(2, "run " + (d / "tiny.toml").string() + " -o " + (d / "two").string(),
                         d / "two.log");
-  const std::string log = slurp(d / "two.log");
+  const std::string log = read_file(d / "two.log");
   ASSERT_EQ(rc, 0) << log;
   // rank 0 alone reports
   EXPECT_EQ(log.find("ibrod: stopped (end_time)"), log.rfind("ibrod: stopped (end_time)")) << log;
@@ -127,7 +130,7 @@ TEST(MpiRun, ARankCountThatDoesNotDivideTheGridIsAnInputErrorOnEveryRank) {
   std::ofstream(d / "tiny.toml") << tiny_config();
   const int rc = mpirun(3, "run " + (d / "tiny.toml").string() + " -o " + (d / "out").string(),
                         d / "log");
-  const std::string log = slurp(d / "log");
+  const std::string log = read_file(d / "log");
   EXPECT_EQ(rc, 2) << log;
   // every rank stopped with the message (none hung: mpirun returned)
   const std::string msg = "grid.n = 16 cannot be split over 3 MPI ranks";
@@ -145,7 +148,7 @@ TEST(MpiRun, ABadConfigIsExit2OnEveryRank) {
   const int rc = mpirun(2, "run " + (d / "tiny.toml").string() + " --set time.dt_ns=-1 -o " +
                                (d / "out").string(),
                         d / "log");
-  EXPECT_EQ(rc, 2) << slurp(d / "log");
+  EXPECT_EQ(rc, 2) << read_file(d / "log");
   fs::remove_all(d);
 }
 
@@ -161,7 +164,7 @@ TEST(MpiRun, CheckpointsMoveBetweenTwoRanksAndOneProcess) {
 
   // 50 steps on 2 ranks, the other 50 in one process
   ASSERT_EQ(mpirun(2, "run " + cfg + half + " -o " + (d / "a").string(), d / "a1.log"), 0)
-      << slurp(d / "a1.log");
+      << read_file(d / "a1.log");
   const auto a = run_ibrod({"run", "--resume", (d / "a").string(), "--set",
                             "time.t_end_us=0.01", "--force"},
                            d / "a2.log");
@@ -173,7 +176,7 @@ TEST(MpiRun, CheckpointsMoveBetweenTwoRanksAndOneProcess) {
                            d / "b1.log");
   ASSERT_EQ(b.code, 0) << b.output;
   ASSERT_EQ(mpirun(2, "run --resume " + (d / "b").string() + full, d / "b2.log"), 0)
-      << slurp(d / "b2.log");
+      << read_file(d / "b2.log");
   expect_same_trajectory(d / "one", d / "b");
   fs::remove_all(d);
 }

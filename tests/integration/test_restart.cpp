@@ -8,6 +8,7 @@
 
 #include "io/checkpoint.hpp"
 #include "io/h5md.hpp"
+#include "helpers.hpp"
 #include "run_helpers.hpp"
 
 using namespace ibrod;
@@ -20,16 +21,20 @@ namespace {
 // threads, so that plans and OpenMP reductions are exercised; checkpoints every 50 steps, rows
 // every 20, frames every 40 (none of them divides the others).
 std::string restart_config() {
-  return "[grid]\nn = 16\nbox_A = 200\n[rod]\nbase_pairs = 100\nexcess_link = 2\n"
-         "[time]\ndt_ns = 0.1\nt_end_us = 0.06\n"
-         "[output]\nevery_steps = 20\nframe_every_steps = 40\ncheckpoint_every_steps = 50\n"
-         "[run]\nthreads = 2\nfftw_measure = true\n";
+  ibrod::config::Config c = ibrod::test::small_config(2);
+  c.time_t_end_us = 0.06;
+  c.output_every_steps = 20;
+  c.output_frame_every_steps = 40;
+  c.output_checkpoint_every_steps = 50;
+  c.run_threads = 2;
+  c.run_fftw_measure = true;
+  return ibrod::test::small_config_toml(c);
 }
 
 void expect_same_run(const fs::path& a, const fs::path& b) {
-  EXPECT_EQ(slurp(a / "timeseries.csv"), slurp(b / "timeseries.csv"));
-  EXPECT_EQ(slurp(a / "final_state.csv"), slurp(b / "final_state.csv"));
-  EXPECT_EQ(slurp(a / "rod.pvd"), slurp(b / "rod.pvd"));
+  EXPECT_EQ(read_file(a / "timeseries.csv"), read_file(b / "timeseries.csv"));
+  EXPECT_EQ(read_file(a / "final_state.csv"), read_file(b / "final_state.csv"));
+  EXPECT_EQ(read_file(a / "rod.pvd"), read_file(b / "rod.pvd"));
   for (const char* e : {"position", "d1", "d2", "d3"}) {
     const io::H5mdSeries sa = io::read_h5md_series(a / "trajectory.h5", e);
     const io::H5mdSeries sb = io::read_h5md_series(b / "trajectory.h5", e);
@@ -37,7 +42,7 @@ void expect_same_run(const fs::path& a, const fs::path& b) {
     EXPECT_EQ(sa.time_us, sb.time_us) << e;
     EXPECT_TRUE(sa.value == sb.value) << e << ": frames differ";  // bitwise
   }
-  EXPECT_EQ(slurp(a / "vtk" / "rod_000600.vtp"), slurp(b / "vtk" / "rod_000600.vtp"));
+  EXPECT_EQ(read_file(a / "vtk" / "rod_000600.vtp"), read_file(b / "vtk" / "rod_000600.vtp"));
 }
 
 class Restart : public ::testing::Test {
@@ -68,7 +73,7 @@ TEST_F(Restart, KilledTwiceAndResumedIsBitwiseIdentical) {
   const fs::path b = root_ / "B";
   // kill -9 after 9 rows (step ≥ 160: checkpoint 150 or later), resume, kill again after 22 rows
   Child c = spawn(run_args("B"), root_ / "B1.log");
-  ASSERT_TRUE(wait_for_lines(c, b / "timeseries.csv", 1 + 9)) << slurp(root_ / "B1.log");
+  ASSERT_TRUE(wait_for_lines(c, b / "timeseries.csv", 1 + 9)) << read_file(root_ / "B1.log");
   ::kill(c.pid, SIGKILL);
   Exit e = wait_for(c);
   ASSERT_EQ(e.signal, SIGKILL) << "the run finished before it could be killed";
@@ -76,7 +81,7 @@ TEST_F(Restart, KilledTwiceAndResumedIsBitwiseIdentical) {
   EXPECT_EQ(ck1 % 50, 0);
 
   c = spawn({"run", "--resume", b.string()}, root_ / "B2.log");
-  ASSERT_TRUE(wait_for_lines(c, b / "timeseries.csv", 1 + 22)) << slurp(root_ / "B2.log");
+  ASSERT_TRUE(wait_for_lines(c, b / "timeseries.csv", 1 + 22)) << read_file(root_ / "B2.log");
   ::kill(c.pid, SIGKILL);
   e = wait_for(c);
   ASSERT_EQ(e.signal, SIGKILL) << "the run finished before it could be killed";
@@ -87,7 +92,7 @@ TEST_F(Restart, KilledTwiceAndResumedIsBitwiseIdentical) {
   expect_same_run(ref(), b);
   // 31 rows, no gap, no duplicate
   EXPECT_EQ(lines_in(b / "timeseries.csv"), 1 + 31);
-  const std::string summary = slurp(b / "summary.json");
+  const std::string summary = read_file(b / "summary.json");
   EXPECT_THAT(summary, HasSubstr("\"resumes\": 2"));
   EXPECT_THAT(summary, HasSubstr("\"stop_reason\": \"end_time\""));
 }
@@ -95,7 +100,7 @@ TEST_F(Restart, KilledTwiceAndResumedIsBitwiseIdentical) {
 TEST_F(Restart, SigtermWritesACheckpointAndTheRunContinuesExactly) {
   const fs::path b = root_ / "T";
   Child c = spawn(run_args("T"), root_ / "T1.log");
-  ASSERT_TRUE(wait_for_lines(c, b / "timeseries.csv", 1 + 12)) << slurp(root_ / "T1.log");
+  ASSERT_TRUE(wait_for_lines(c, b / "timeseries.csv", 1 + 12)) << read_file(root_ / "T1.log");
   ::kill(c.pid, SIGTERM);
   Exit e = wait_for(c);
   ASSERT_EQ(e.code, 128 + SIGTERM) << e.output;
@@ -104,7 +109,7 @@ TEST_F(Restart, SigtermWritesACheckpointAndTheRunContinuesExactly) {
   // the checkpoint is of the step the signal arrived in, not of the last periodic one
   const io::Checkpoint ck = io::read_checkpoint(b / "checkpoint.bin");
   EXPECT_GE(ck.meta.step, 220);
-  EXPECT_THAT(slurp(b / "summary.json"), HasSubstr("\"stop_reason\": \"interrupted\""));
+  EXPECT_THAT(read_file(b / "summary.json"), HasSubstr("\"stop_reason\": \"interrupted\""));
 
   e = run_ibrod({"run", "--resume", b.string()}, root_ / "T2.log");
   ASSERT_EQ(e.code, 0) << e.output;
@@ -114,7 +119,7 @@ TEST_F(Restart, SigtermWritesACheckpointAndTheRunContinuesExactly) {
 TEST_F(Restart, DamagedOrForeignCheckpointsAreRefused) {
   const fs::path d = root_ / "D";
   fs::copy(ref(), d, fs::copy_options::recursive);
-  const std::string good = slurp(d / "checkpoint.bin");
+  const std::string good = read_file(d / "checkpoint.bin");
   auto resume = [&](std::vector<std::string> extra = {}) {
     std::vector<std::string> args{"run", "--resume", d.string()};
     args.insert(args.end(), extra.begin(), extra.end());
@@ -141,18 +146,19 @@ TEST_F(Restart, DamagedOrForeignCheckpointsAreRefused) {
   EXPECT_EQ(e.code, 2) << e.output;
   EXPECT_THAT(e.output, HasSubstr("corrupt"));
 
-  // another configuration: refused, unless forced; another grid: refused even when forced
+  // another configuration: refused, unless forced (a later t_end alone is an extension, which
+  // needs no --force: test_no_data_lost.cpp); another grid: refused even when forced
   put(good);
-  e = resume({"--set", "time.t_end_us=0.07"});
+  e = resume({"--set", "solvent.salt_M=0.05"});
   EXPECT_EQ(e.code, 2) << e.output;
-  EXPECT_THAT(e.output, HasSubstr("time.t_end_us: 0.06 → 0.07"));
+  EXPECT_THAT(e.output, HasSubstr("solvent.salt_M: 0.1 → 0.05"));
   EXPECT_THAT(e.output, HasSubstr("--force"));
   e = resume({"--set", "grid.n=32", "--force"});
   EXPECT_EQ(e.code, 2) << e.output;
   EXPECT_THAT(e.output, HasSubstr("incompatible"));
   e = resume({"--set", "time.t_end_us=0.07", "--force"});
   EXPECT_EQ(e.code, 0) << e.output;
-  EXPECT_THAT(slurp(d / "config.toml"), HasSubstr("t_end_us = 0.07"));
+  EXPECT_THAT(read_file(d / "config.toml"), HasSubstr("t_end_us = 0.07"));
   EXPECT_EQ(lines_in(d / "timeseries.csv"), 1 + 36);  // rows 0, 20, …, 700
 
   // no checkpoint at all
@@ -178,8 +184,8 @@ TEST_F(Restart, AFullDiskStopsWithAMessageAndTheRunCanBeResumed) {
 
   e = run_ibrod({"run", "--resume", f.string()}, root_ / "F2.log");
   ASSERT_EQ(e.code, 0) << e.output;
-  EXPECT_EQ(slurp(ref() / "timeseries.csv"), slurp(f / "timeseries.csv"));
-  EXPECT_EQ(slurp(ref() / "final_state.csv"), slurp(f / "final_state.csv"));
+  EXPECT_EQ(read_file(ref() / "timeseries.csv"), read_file(f / "timeseries.csv"));
+  EXPECT_EQ(read_file(ref() / "final_state.csv"), read_file(f / "final_state.csv"));
 }
 
 TEST(SafeFailure, ATimeStepFarTooLargeStopsWithinOneOutputInterval) {
@@ -194,7 +200,7 @@ TEST(SafeFailure, ATimeStepFarTooLargeStopsWithinOneOutputInterval) {
   EXPECT_THAT(e.output, HasSubstr("time step is probably too large"));
   EXPECT_THAT(e.output, HasSubstr("time.dt_ns = 2"));
   EXPECT_THAT(e.output, HasSubstr("last good checkpoint (step 0)"));
-  const std::string summary = slurp(d / "out" / "summary.json");
+  const std::string summary = read_file(d / "out" / "summary.json");
   EXPECT_THAT(summary, HasSubstr("\"stop_reason\": \"blow_up\""));
   const std::int64_t step = std::stoll(e.output.substr(e.output.find("blow-up at step ") + 16));
   EXPECT_GE(step, 1);

@@ -1,4 +1,4 @@
-// Sweeps end to end (io/sweep.hpp, `ibrod sweep`): the points run as real `ibrod run` processes;
+// Sweeps end to end (driver/sweep_runner.hpp, `ibrod sweep`): the points run as real `ibrod run` processes;
 // a sweep stopped part-way and started again finishes every point exactly once (finished points
 // skipped, the interrupted one resumed from its checkpoint, bitwise as if never stopped); a failed
 // point is reported and the others finish; under mpirun the ranks share the points.
@@ -7,7 +7,9 @@
 
 #include <cstdlib>
 
+#include "driver/dir_lock.hpp"
 #include "driver/sweep_runner.hpp"
+#include "helpers.hpp"
 #include "run_helpers.hpp"
 
 using namespace ibrod;
@@ -19,10 +21,13 @@ namespace {
 // 16³, 100 points, 200 Å box: 4 points (ΔLk 1, 2 × Cs 0.05, 0.1) of 1500 steps, checkpoints
 // every 100 steps, one thread each so that two can run side by side.
 std::string tiny_sweep() {
-  return "[grid]\nn = 16\nbox_A = 200\n[rod]\nbase_pairs = 100\n"
-         "[time]\ndt_ns = 0.1\nt_end_us = 0.15\n"
-         "[output]\nevery_steps = 50\nframe_every_steps = 0\ncheckpoint_every_steps = 100\n"
-         "[run]\nthreads = 1\nfftw_measure = false\n"
+  ibrod::config::Config c = ibrod::test::small_config(1);
+  c.time_t_end_us = 0.15;
+  c.output_every_steps = 50;
+  c.output_frame_every_steps = 0;
+  c.output_checkpoint_every_steps = 100;
+  c.run_threads = 1;
+  return ibrod::test::small_config_toml(c) +
          "[sweep]\n\"rod.excess_link\" = [1, 2]\n\"solvent.salt_M\" = [0.05, 0.1]\n";
 }
 
@@ -36,14 +41,14 @@ driver::SweepOptions options(const fs::path& root, int jobs, std::FILE* log = nu
 }
 
 std::string stop_reason(const fs::path& dir) {
-  const std::string s = slurp(dir / "summary.json");
+  const std::string s = read_file(dir / "summary.json");
   const auto p = s.find("\"stop_reason\": \"");
   return p == std::string::npos ? "" : s.substr(p + 16, s.find('"', p + 16) - p - 16);
 }
 
 // steps of the time series, in file order
 std::vector<long> steps_of(const fs::path& dir) {
-  std::istringstream in(slurp(dir / "timeseries.csv"));
+  std::istringstream in(read_file(dir / "timeseries.csv"));
   std::string line;
   std::getline(in, line);  // header
   std::vector<long> steps;
@@ -113,20 +118,20 @@ TEST(SweepRun, InterruptedPartWayAndStartedAgainFinishesEveryPointExactlyOnce) {
     for (long s = 0; s <= 1500; s += 50) want.push_back(s);
     EXPECT_EQ(steps_of(dir(i)), want) << i;
   }
-  EXPECT_THAT(slurp(dir(1) / "summary.json"), HasSubstr("\"resumes\": 1"));
+  EXPECT_THAT(read_file(dir(1) / "summary.json"), HasSubstr("\"resumes\": 1"));
   // the resumed point is bitwise the uninterrupted run of its config
   const Exit e = run_ibrod({"run", (root / "configs" / (sw.points[1].name + ".toml")).string(),
                             "-o", (d / "direct").string()},
                            d / "direct.log");
   ASSERT_EQ(e.code, 0) << e.output;
-  EXPECT_EQ(slurp(dir(1) / "final_state.csv"), slurp(d / "direct" / "final_state.csv"));
-  EXPECT_EQ(slurp(dir(1) / "timeseries.csv"), slurp(d / "direct" / "timeseries.csv"));
+  EXPECT_EQ(read_file(dir(1) / "final_state.csv"), read_file(d / "direct" / "final_state.csv"));
+  EXPECT_EQ(read_file(dir(1) / "timeseries.csv"), read_file(d / "direct" / "timeseries.csv"));
 
   // 3. a third time: nothing to do
   const driver::SweepReport again = driver::run_sweep(sw, options(root, 2));
   EXPECT_EQ(again.skipped, 4);
   EXPECT_EQ(again.fresh + again.resumed + again.failed, 0);
-  EXPECT_THAT(slurp(root / "points.csv"), HasSubstr("1,dlk=1_salt_M=0.1,1,0.1\n"));
+  EXPECT_THAT(read_file(root / "points.csv"), HasSubstr("1,dlk=1_salt_M=0.1,1,0.1\n"));
   fs::remove_all(d);
 }
 
@@ -144,7 +149,7 @@ TEST(SweepRun, AFailedPointIsReportedAndTheOthersFinish) {
   EXPECT_EQ(r.failed_names, std::vector<std::string>{"dt_ns=2"});
   EXPECT_EQ(r.completed, 1);
   EXPECT_EQ(stop_reason(d / "out" / "dt_ns=0.1"), "end_time");
-  EXPECT_THAT(slurp(d / "out" / "logs" / "dt_ns=2.log"), HasSubstr("blow-up"));
+  EXPECT_THAT(read_file(d / "out" / "logs" / "dt_ns=2.log"), HasSubstr("blow-up"));
   // again: the blown-up point is reported, not re-run; the finished one skipped
   const driver::SweepReport again = driver::run_sweep(sw, options(d / "out", 2));
   EXPECT_EQ(again.failed, 1);
@@ -163,10 +168,10 @@ TEST(SweepRun, APointDirectoryOfAnotherConfigurationIsNotTouched) {
   std::ofstream(d / "sweep.toml")
       << "[grid]\nn = 16\nbox_A = 200\n[rod]\nbase_pairs = 100\n[time]\nt_end_us = 0.02\n"
          "[run]\nthreads = 1\nfftw_measure = false\n[sweep]\n\"rod.excess_link\" = [3]\n";
-  const std::string before = slurp(d / "out" / "dlk=3" / "summary.json");
+  const std::string before = read_file(d / "out" / "dlk=3" / "summary.json");
   const driver::SweepReport r = driver::run_sweep(driver::load_sweep(d / "sweep.toml"), options(d / "out", 1));
   EXPECT_EQ(r.failed, 1);
-  EXPECT_EQ(slurp(d / "out" / "dlk=3" / "summary.json"), before);
+  EXPECT_EQ(read_file(d / "out" / "dlk=3" / "summary.json"), before);
   fs::remove_all(d);
 }
 
@@ -216,7 +221,7 @@ TEST(SweepCommand, UnderMpirunTheRanksShareThePoints) {
                               std::string(IBROD_BINARY) + " sweep " + (d / "sweep.toml").string() +
                               " > " + (d / "mpi.log").string() + " 2>&1")
                                  .c_str());
-  const std::string log = slurp(d / "mpi.log");
+  const std::string log = read_file(d / "mpi.log");
   ASSERT_EQ(rc, 0) << log;
   EXPECT_THAT(log, HasSubstr("sweep[0]: 2 points (rank 0 of 2)"));
   EXPECT_THAT(log, HasSubstr("sweep[1]: 2 points (rank 1 of 2)"));
@@ -225,4 +230,61 @@ TEST(SweepCommand, UnderMpirunTheRanksShareThePoints) {
     EXPECT_EQ(stop_reason(d / "out" / n), "end_time") << n;
   fs::remove_all(d);
 #endif
+}
+
+TEST(SweepRun, APointWrittenByAnotherProcessIsNotStartedAndNotCountedFinished) {
+  // the orphaned run of a killed sweep still writes point 0 (here: this process holds its lock);
+  // the rerun sweep must not start a second writer there, nor call the point finished
+  const fs::path d = fresh_dir("sweep_locked");
+  std::ofstream(d / "sweep.toml") << tiny_sweep();
+  const driver::Sweep sw = driver::load_sweep(d / "sweep.toml");
+  const fs::path root = d / "out";
+  const fs::path point0 = root / sw.points[0].name;
+  fs::create_directories(point0);
+  std::ofstream(point0 / "timeseries.csv") << "step,time_us\n";  // the other writer's file
+  {
+    const driver::DirLock held(point0);
+    EXPECT_EQ(driver::point_state(point0), driver::PointState::running);
+    const driver::SweepReport r = driver::run_sweep(sw, options(root, 2));
+    EXPECT_EQ(r.running, 1);
+    EXPECT_EQ(r.completed, 3);
+    EXPECT_EQ(r.failed, 0);
+    EXPECT_EQ(read_file(point0 / "timeseries.csv"), "step,time_us\n");  // untouched
+    EXPECT_FALSE(fs::exists(point0 / "summary.json"));
+  }
+  // once the other writer is gone the point is run like any interrupted or fresh one
+  EXPECT_NE(driver::point_state(point0), driver::PointState::running);
+  fs::remove_all(d);
+}
+
+TEST(SweepRun, PointKRunsThatPointAloneAndListNumbersThem) {
+  // a scheduler's job array: `ibrod sweep SWEEP.toml --point K` per task
+  const fs::path d = fresh_dir("sweep_point");
+  std::ofstream(d / "sweep.toml") << tiny_sweep();
+  const driver::Sweep sw = driver::load_sweep(d / "sweep.toml");
+  const fs::path root = d / "out";
+  const Exit list = run_ibrod({"sweep", (d / "sweep.toml").string(), "-o", root.string(), "--list"},
+                              d / "list.log");
+  ASSERT_EQ(list.code, 0) << list.output;
+  EXPECT_THAT(list.output, ::testing::HasSubstr("   2  " + sw.points[2].name));
+  const Exit one = run_ibrod({"sweep", (d / "sweep.toml").string(), "-o", root.string(),
+                              "--point", "2"},
+                             d / "one.log");
+  ASSERT_EQ(one.code, 0) << one.output;
+  for (std::size_t i = 0; i < sw.points.size(); ++i)
+    EXPECT_EQ(driver::point_state(root / sw.points[i].name),
+              i == 2 ? driver::PointState::finished : driver::PointState::fresh)
+        << sw.points[i].name;
+  // again: skipped as finished; a point that does not exist is refused
+  const Exit again = run_ibrod({"sweep", (d / "sweep.toml").string(), "-o", root.string(),
+                                "--point", "2"},
+                               d / "again.log");
+  EXPECT_EQ(again.code, 0);
+  EXPECT_THAT(again.output, ::testing::HasSubstr("1 finished, 0 to run"));
+  const Exit bad = run_ibrod({"sweep", (d / "sweep.toml").string(), "-o", root.string(),
+                              "--point", "4"},
+                             d / "bad.log");
+  EXPECT_EQ(bad.code, 2) << bad.output;
+  EXPECT_THAT(bad.output, ::testing::HasSubstr("--point 4"));
+  fs::remove_all(d);
 }

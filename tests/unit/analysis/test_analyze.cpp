@@ -1,4 +1,4 @@
-// Post-processing of a run directory (io/analyze.hpp) on synthetic files: CSV reading (a row cut
+// Post-processing of a run directory (analysis/analyze.hpp, analysis/frames.hpp) on synthetic files: CSV reading (a row cut
 // short by a killed run is dropped, a malformed one is an error), the analysis of a series with
 // known answers, the atomic merge into summary.json (other keys kept, bad JSON refused and left
 // untouched), config.toml, --size, and render_run on a known ring.
@@ -39,7 +39,7 @@ struct TempDir {
 
 void write(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
 
-std::string slurp(const fs::path& p) {
+std::string read_file(const fs::path& p) {
   std::ifstream in(p);
   std::stringstream ss;
   ss << in.rdbuf();
@@ -109,7 +109,7 @@ TEST(Analyze, MergesIntoSummaryAtomicallyAndKeepsOtherKeys) {
   write(d.path / "timeseries.csv", synthetic_timeseries(201, 0.01));
   write(d.path / "summary.json", R"({"steps": 2000, "stop_reason": "equilibrium", "writhe_convergence_time_us": 99})");
   analyze_run(d.path);
-  const auto j = nlohmann::json::parse(slurp(d.path / "summary.json"));
+  const auto j = nlohmann::json::parse(read_file(d.path / "summary.json"));
   EXPECT_EQ(j["steps"], 2000);
   EXPECT_EQ(j["stop_reason"], "equilibrium");
   EXPECT_NEAR(j["writhe_convergence_time_us"].get<double>(), 0.1 * std::log(80.0), 1e-3);  // replaced
@@ -124,7 +124,7 @@ TEST(Analyze, MergesIntoSummaryAtomicallyAndKeepsOtherKeys) {
   // a summary that is not JSON is refused and left as it was
   write(d.path / "summary.json", "{not json");
   EXPECT_THROW(analyze_run(d.path), ConfigError);
-  EXPECT_EQ(slurp(d.path / "summary.json"), "{not json");
+  EXPECT_EQ(read_file(d.path / "summary.json"), "{not json");
   // no time series: bad input
   fs::remove(d.path / "timeseries.csv");
   EXPECT_THROW(analyze_run(d.path), ConfigError);
@@ -167,7 +167,7 @@ TEST(Analyze, CircularRunGetsAPowerLaw) {
   ASSERT_TRUE(a.kinetic_power_law_exponent);
   EXPECT_NEAR(*a.kinetic_power_law_exponent, -1.5, 1e-6);
   EXPECT_EQ(a.writhe_convergence_time_us, 0.0);  // Wr constant: inside the band from the start
-  const auto j = nlohmann::json::parse(slurp(d.path / "summary.json"));  // created
+  const auto j = nlohmann::json::parse(read_file(d.path / "summary.json"));  // created
   EXPECT_NEAR(j["kinetic_power_law_exponent"].get<double>(), -1.5, 1e-6);
 }
 

@@ -10,7 +10,7 @@
 
 #include "core/types.hpp"
 
-namespace ibrod::diag::testing {
+namespace ibrod::diagnostics::testing {
 
 inline constexpr double pi = std::numbers::pi;
 
@@ -64,7 +64,7 @@ inline SmoothCurve random_fourier_curve(std::mt19937_64& rng, int modes) {
 
 /// Klenin & Langowski, Biopolymers 54 (2000) 307, method 1b, as published: the solid angle of
 /// the segment pair p1→p2, p3→p4 from the four face normals and asin terms. The slow oracle for
-/// diag::segment_pair_solid_angle (same quantity, different formula).
+/// diagnostics::segment_pair_solid_angle (same quantity, different formula).
 inline double solid_angle_kl1b(const Vec3& p1, const Vec3& p2, const Vec3& p3, const Vec3& p4) {
   const Vec3 r12 = p2 - p1, r34 = p4 - p3;
   const Vec3 r13 = p3 - p1, r14 = p4 - p1, r23 = p3 - p2, r24 = p4 - p2;
@@ -128,4 +128,4 @@ inline double spherical_polygon_area(const std::vector<Vec3>& t, const Vec3& e) 
 /// x reduced to (−p/2, p/2] modulo p.
 inline double mod_centered(double x, double p) { return x - p * std::round(x / p); }
 
-}  // namespace ibrod::diag::testing
+}  // namespace ibrod::diagnostics::testing

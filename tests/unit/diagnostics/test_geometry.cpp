@@ -10,7 +10,7 @@
 #include "curves.hpp"
 #include "diagnostics/topology.hpp"
 
-namespace ibrod::diag {
+namespace ibrod::diagnostics {
 namespace {
 
 using namespace testing;
@@ -72,4 +72,4 @@ TEST(MeanSpacing, Rectangle) {
 }
 
 }  // namespace
-}  // namespace ibrod::diag
+}  // namespace ibrod::diagnostics

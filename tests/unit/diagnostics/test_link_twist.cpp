@@ -10,7 +10,7 @@
 #include "curves.hpp"
 #include "diagnostics/topology.hpp"
 
-namespace ibrod::diag {
+namespace ibrod::diagnostics {
 namespace {
 
 using namespace testing;
@@ -156,4 +156,4 @@ TEST(Twist, SizeMismatchThrows) {
 }
 
 }  // namespace
-}  // namespace ibrod::diag
+}  // namespace ibrod::diagnostics

@@ -11,7 +11,7 @@
 
 #include "diagnostics/relaxation.hpp"
 
-namespace ibrod::diag {
+namespace ibrod::diagnostics {
 namespace {
 
 std::vector<double> linspace(double a, double b, int n) {
@@ -179,4 +179,4 @@ TEST(Series, SizeMismatchThrows) {
 }
 
 }  // namespace
-}  // namespace ibrod::diag
+}  // namespace ibrod::diagnostics

@@ -11,7 +11,7 @@
 #include "curves.hpp"
 #include "diagnostics/topology.hpp"
 
-namespace ibrod::diag {
+namespace ibrod::diagnostics {
 namespace {
 
 using namespace testing;
@@ -180,4 +180,4 @@ TEST(Writhe, FullersTheoremModTwo) {
 }
 
 }  // namespace
-}  // namespace ibrod::diag
+}  // namespace ibrod::diagnostics

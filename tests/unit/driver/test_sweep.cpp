@@ -1,4 +1,4 @@
-// Sweep files (io/sweep.hpp): the product of lists, stable point names, base configs, and every
+// Sweep files (driver/sweep_file.hpp): the product of lists, stable point names, base configs, and every
 // kind of bad sweep file is a ConfigError naming the key.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

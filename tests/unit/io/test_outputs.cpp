@@ -127,7 +127,7 @@ TEST(H5md, FramesAppendTruncateOnResumeAndReadBack) {
   }
   {
     // a resume from step 7 drops frames 10 and 15, then a new frame 10 follows
-    auto w = io::H5mdWriter::reopen(d / "t.h5", n, 7, "[grid]\nn = 16\n");
+    auto w = io::H5mdWriter::reopen(d / "t.h5", n, 200.0, 7, "[grid]\nn = 16\n");
     EXPECT_EQ(w->frames(), 2);
     w->write_frame(10, 10e-4, frame(11));
   }
@@ -142,7 +142,7 @@ TEST(H5md, FramesAppendTruncateOnResumeAndReadBack) {
   for (int k = 0; k < n; ++k)
     for (int i = 0; i < 3; ++i) EXPECT_EQ(d2.value[(2 * n + k) * 3 + i], last.D[k](i, 1));
   // a rod of another size cannot continue this file
-  EXPECT_THROW(io::H5mdWriter::reopen(d / "t.h5", n + 1, 7, ""), RunError);
+  EXPECT_THROW(io::H5mdWriter::reopen(d / "t.h5", n + 1, 200.0, 7, ""), RunError);
   fs::remove_all(d);
 }
 
@@ -150,7 +150,7 @@ TEST(H5md, UnreadableFileIsARunError) {
   const fs::path d = scratch("h5bad");
   std::ofstream(d / "bad.h5") << "this is not HDF5";
   try {
-    io::H5mdWriter::reopen(d / "bad.h5", 5, 0, "");
+    io::H5mdWriter::reopen(d / "bad.h5", 5, 200.0, 0, "");
     FAIL() << "no error";
   } catch (const RunError& e) {
     EXPECT_THAT(e.what(), HasSubstr("bad.h5"));
