@@ -5,22 +5,23 @@
 // a linear map from the rod's point forces and torques g = (F_k, T_k) to its velocities and
 // angular velocities (U_k, W_k):
 //   M g = interpolate ∘ (−μL_h)⁻¹ P ∘ spread g        (one Stokes solve, FluidSolver::solve_stokes)
-// and the rod is overdamped: q̇ = M g(q), q = (X_k, θ_k) (positions, lab-frame rotation vectors
+// and the rod is overdamped: q̇ = M F(q), q = (X_k, θ_k) (positions, lab-frame rotation vectors
 // of the triads). Forward Euler in this form is the explicit scheme; its Δt is bounded by the
-// stretch/shear/bend/twist stiffness at the kernel scale. The implicit force of the linearly
-// implicit Euler step is
-//   g = F(qⁿ) + H δ,  δ = Δt M g  ⇒  (I + Δt K M) g = F(qⁿ),   K = −H = −∂F/∂q   (1)
-// (F = elastic + electrostatic + steric; K = elastic stiffness only: the pair forces stay
-// explicit). This class solves (1) by GMRES, right-preconditioned with the same system for a
-// local (scalar, self) mobility M_loc = diag(β m_t I, β m_r I):
-//   P = (I + Δt K M_loc)⁻¹     (block-tridiagonal periodic, one sparse LU per refresh of K)
-// starting from g₀ = P F. With no Krylov iteration (krylov_max_iter = 0) the step is the IMEX
-// scheme "implicit force, explicit mobility":
-//   g = (I + Δt K M_loc)⁻¹ F(qⁿ),  δ = Δt M g                                             (2)
-// — one Stokes solve per step, and the rod still moves with the interpolated fluid velocity of
-// the force it spreads. Both are first order for any M_loc and any approximation of K (they
-// differ from forward Euler by O(Δt²)); stability needs M_loc K ≈ M K on the stiff modes
-// (docs/large_dt.md: β ≥ ~½ max M(q)/m over the modes that Δt makes stiff).
+// stretch/shear/bend/twist stiffness at the kernel scale. With K the elastic stiffness (the
+// Gauss–Newton K = Δs Σ Jᵀ C J by default, plus the steric contacts; the pair forces stay
+// explicit) and a local mobility M_loc = diag(β m_t I, β m_r I) (m_t, m_r the self mobilities
+// of one kernel-spread point), the step is (velocity form, the default and the scheme chosen in
+// docs/large_dt.md)
+//   u = (I + Δt M_loc K)⁻¹ M F(qⁿ),   δ = Δt u                                         (1)
+// one Stokes solve and one sparse (block-cyclic) Cholesky solve of M_loc⁻¹ + Δt K per step; its
+// fixed points are the explicit scheme's (M F = 0). Optionally GMRES, right-preconditioned by
+// the same system, solves the linearly implicit Euler step (I + Δt M K) u = M F from (1)
+// (krylov_max_iter > 0; one Stokes solve per iteration). The force form
+//   g = (I + Δt K M_loc)⁻¹ F(qⁿ),  δ = Δt M g                                          (2)
+// (velocity_form = false; with GMRES (I + Δt K M) g = F) was measured and not chosen: its fixed
+// points move with Δt and it does not decrease the energy. All are first order for any M_loc and
+// any approximation of K (they differ from forward Euler by O(Δt²)); stability needs
+// M_loc K ≈ M K on the stiff modes (docs/large_dt.md: β ≥ 8).
 // Finally X ← X + δ_X, D ← R(δ_θ) D (Rodrigues): the link is conserved as long as the rod does
 // not pass through itself, and the triads stay orthonormal.
 #include <Eigen/Sparse>
@@ -36,8 +37,8 @@
 namespace ibrod::integrate {
 
 struct ImplicitParams {
-  double mobility_scale = 2.0;   ///< β: M_loc = β × the kernel's self mobility (≥ 0)
-  int krylov_max_iter = 0;       ///< GMRES iterations after the IMEX guess (0: scheme (2))
+  double mobility_scale = 8.0;   ///< β: M_loc = β × the kernel's self mobility (≥ 0; 0: explicit)
+  int krylov_max_iter = 0;       ///< GMRES iterations after the IMEX guess (0: scheme (1))
   double krylov_tol = 1e-2;      ///< relative residual of (1) at which GMRES stops
   /// trial steps between refreshes of K and of its factorisation (≥ 1; K at qⁿ when refreshed,
   /// and whenever Δt changes). 1: K is a function of the state alone, so a run resumed from any

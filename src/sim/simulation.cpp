@@ -77,8 +77,10 @@ Simulation::Simulation(const SimParams& p)
 
 void Simulation::step() {
   if (implicit_) {
-    // the last step lands on t_end
-    time_ += implicit_->advance(rod_, std::max(p_.t_end - time_, p_.adaptive.dt_min));
+    // the last step lands on t_end (a stability probe may step beyond it: no cap there)
+    const double left = p_.t_end - time_;
+    const double cap = left > 0 ? std::max(left, p_.adaptive.dt_min) : HUGE_VAL;
+    time_ += implicit_->advance(rod_, cap);
     ++step_;
     return;
   }

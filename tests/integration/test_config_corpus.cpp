@@ -179,7 +179,10 @@ std::vector<Case> generated() {
       "solvent.viscosity_poise", "solvent.density_g_cm3", "solvent.temperature_K",
       "electrostatics.charge_e", "electrostatics.dielectric", "electrostatics.cutoff_debye",
       "steric.diameter_A", "steric.stiffness", "output.every_steps", "output.frame_every_steps",
-      "output.checkpoint_every_steps", "run.threads"};
+      "output.checkpoint_every_steps", "run.threads", "time.max_displacement_A",
+      "time.energy_tolerance_kT", "time.dt_min_ns", "time.implicit_mobility_scale",
+      "time.implicit_jacobian_every", "time.implicit_krylov_iterations",
+      "time.implicit_krylov_tol"};
   const char* boolean[] = {"solvent.advection", "electrostatics.enabled", "steric.enabled",
                            "output.fluid_vti", "output.fluid_velocity", "run.fftw_measure"};
   std::vector<Case> out;
