@@ -2,8 +2,14 @@
 // analysis/frames.hpp.
 #include "cmd_analysis.hpp"
 
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <exception>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <string>
@@ -34,9 +40,48 @@ std::string join(const std::vector<std::string>& v) {
   return s;
 }
 
+/// python/ibrod_report.py: $IBROD_REPORT_SCRIPT, else beside the source tree of a build directory
+/// (build/app/ibrod → python/), else installed beside the binary (../share/ibrod/).
+std::filesystem::path report_script() {
+  namespace fs = std::filesystem;
+  if (const char* env = std::getenv("IBROD_REPORT_SCRIPT")) return env;
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec)
+    for (const fs::path& p : {exe.parent_path() / "../../python/ibrod_report.py",
+                              exe.parent_path() / "../share/ibrod/ibrod_report.py"})
+      if (fs::exists(p)) return fs::weakly_canonical(p);
+  throw ibrod::ConfigError(
+      "ibrod report: python/ibrod_report.py not found (set IBROD_REPORT_SCRIPT to its path)");
+}
+
 }  // namespace
 
 void add_analysis_commands(CLI::App& app) {
+  // ---- report: the Python report, called the same way (docs/analysis.md)
+  auto* report = app.add_subcommand(
+      "report", "write the report of a sweep (tables, figures, contact sheet) with "
+                "python/ibrod_report.py: ibrod report RUN_DIR... -o REPORT_DIR [--frames]; the "
+                "binary is passed as --ibrod, so runs are analysed first");
+  report->prefix_command();  // every argument goes to the script
+  report->callback([report] {
+    finish([&] {
+      const std::string script = report_script().string();
+      std::error_code ec;
+      const std::string self = std::filesystem::read_symlink("/proc/self/exe", ec).string();
+      std::vector<std::string> args{"/usr/bin/python3", script};
+      for (const auto& r : report->remaining()) args.push_back(r);
+      if (!ec) args.insert(args.end(), {"--ibrod", self});
+      std::vector<char*> argv;
+      for (auto& a : args) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      std::fflush(stdout);
+      ::execv(argv[0], argv.data());
+      throw ibrod::RunError(std::string("ibrod report: cannot run /usr/bin/python3: ") +
+                            std::strerror(errno));
+    });
+  });
+
   // ---- analyze
   struct AnalyzeArgs {
     std::string dir;
@@ -46,7 +91,8 @@ void add_analysis_commands(CLI::App& app) {
   auto a = std::make_shared<AnalyzeArgs>();
   auto* analyze = app.add_subcommand(
       "analyze", "add the time-series analysis (writhe convergence, relaxation time τ, transient "
-                 "states, power law) to DIR/summary.json; see docs/analysis.md");
+                 "states, power law) and the shape of the final state (with --frames of every "
+                 "frame) to DIR/summary.json; see docs/analysis.md");
   analyze->add_option("dir", a->dir, "run directory (written by ibrod run)")->required();
   analyze->add_option("--delta", a->opt.writhe_delta,
                       "band |Wr − Wr(∞)| of the writhe convergence time")
@@ -56,10 +102,20 @@ void add_analysis_commands(CLI::App& app) {
                       "largest |residual| of ln E_K in a fit window (0.02: 2 %)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  analyze->add_flag("-q,--quiet", a->quiet, "print nothing on success");
+  analyze->add_flag("--frames", a->opt.every_frame,
+                    "also the shape of every frame of DIR/trajectory.h5 (summary.json shape_frames)");
+  analyze->add_option("--contact-distance", a->opt.contact_distance_A,
+                      "contact distance d_c in Å (default: D + 3 Debye lengths of config.toml)")
+      ->check(CLI::PositiveNumber);
+  analyze->add_option("--tau-window", a->opt.tau_window_us, "window of τ(t) in µs")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  analyze->add_flag("-q,--quiet", a->quiet, "print nothing on success (warnings still go to stderr)");
   analyze->callback([a] {
     finish([&] {
       const auto result = ibrod::analysis::analyze_run(a->dir, a->opt);
+      for (const auto& w : result.warnings)
+        std::fprintf(stderr, "ibrod analyze: warning: %s: %s\n", a->dir.c_str(), w.c_str());
       if (!a->quiet) std::printf("%s\n", ibrod::analysis::analysis_json(result, a->opt).c_str());
     });
   });

@@ -108,6 +108,7 @@ int check_main(const ConfigArgs& a) {
     const cfg::Config c = resolve(a);
     std::printf("# resolved configuration\n%s\n# derived quantities\n%s",
                 cfg::describe(c).c_str(), cfg::derived_report(c).c_str());
+    for (const std::string& w : cfg::check_warnings(c)) std::printf("# warning: %s\n", w.c_str());
     // a config may be meant for a larger machine: `check` warns where `run` would refuse
     try {
       cfg::check_memory(c);

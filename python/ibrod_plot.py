@@ -7,7 +7,9 @@ overlaid, as one PNG.
 Each RUN_DIR is an output directory of `ibrod run` (timeseries.csv, config.toml). When
 `ibrod analyze RUN_DIR` has been run, its summary.json adds the writhe convergence time (dotted
 line on the writhe panel), the transient states (circles on the energy panels) and the fitted
-exponential final approach of E_K (dashed). Runs are labelled by ΔLk and Cs from config.toml.
+exponential final approach of E_K (dashed). Runs are labelled by ΔLk and Cs from config.toml, and
+"not finished" when summary.json's stop_reason is not "equilibrium" (their writhe convergence
+time and τ are null, so neither is drawn).
 Needs numpy and matplotlib (Debian: python3-numpy python3-matplotlib); use /usr/bin/python3.
 """
 import argparse
@@ -52,6 +54,13 @@ class Run:
     def salt_M(self):
         return self.config.get("solvent", {}).get("salt_M")
 
+    @property
+    def finished(self):
+        """True when the run reached equilibrium (summary.json stop_reason), None when unknown."""
+        if "stop_reason" not in self.summary:
+            return None
+        return self.summary["stop_reason"] == "equilibrium"
+
     def label(self, with_name=False):
         parts = []
         if self.excess_link is not None:
@@ -59,7 +68,8 @@ class Run:
         if self.salt_M is not None:
             parts.append(f"Cs = {self.salt_M:g} M")
         text = ", ".join(parts) or self.name
-        return f"{text} ({self.name})" if with_name and parts else text
+        text = f"{text} ({self.name})" if with_name and parts else text
+        return text if self.finished is not False else text + " — not finished"
 
 
 def plot_runs(runs, out, logt=False, title=None):
@@ -79,7 +89,7 @@ def plot_runs(runs, out, logt=False, title=None):
         ax_w.plot(t, ts["writhe"], color=c)
 
         s = run.summary
-        tc = s.get("writhe_convergence_time_us")
+        tc = s.get("writhe_convergence_time_us")  # null for a run that did not finish
         if tc is not None:
             ax_w.axvline(tc, color=c, linestyle=":", linewidth=1)
         for tr in s.get("transients") or []:

@@ -1,25 +1,28 @@
 #!/usr/bin/python3
-"""A report on a sweep of ibrod runs (MODEL §7): final shapes, energies, writhe and closest
-approach against ΔLk, time series, and tables of writhe convergence and relaxation times.
+"""The report of a sweep of ibrod runs (MODEL §7), one markdown page with PNG figures in the
+layout of a paper.
 
-    python/ibrod_report.py RUN_DIR... -o REPORT_DIR [--view oblique] [--ibrod BINARY]
+    python/ibrod_report.py RUN_DIR... -o REPORT_DIR [--view oblique] [--ibrod BINARY] [--frames]
+                           [--tau-window US]
 
 Writes into REPORT_DIR:
-  report.md         the runs, and tables (rows ΔLk, columns Cs) of the writhe convergence time,
-                    the relaxation time τ and the transient states, with the figures below
-  runs.csv          one row per run: directory, ΔLk, Cs, stop reason, final observables and the
-                    analysis numbers
-  shapes.png        contact sheet of the final shapes: rows ΔLk, columns Cs (the PNG that
-                    `ibrod render` wrote for --view if there is one, else a 3-D line drawing of
-                    final_state.csv)
-  vs_excess_link.png  final total and elastic energy, writhe and closest approach against ΔLk,
-                    one line per Cs
-  timeseries_Cs<c>.png  total energy, kinetic energy and writhe against time, one per Cs
+  report.md           the runs; tables with rows ΔLk and columns Cs of the writhe convergence
+                      time, the relaxation time τ, the final shapes (class, loops, Wr, closest
+                      approach) and the transient states; the figures below
+  runs.csv            one row per run: ΔLk, Cs, stop reason, final observables, the analysis
+  vs_excess_link.png  E_bend, E_twist, ΔE_electro, Wr and closest approach of the final state
+                      against ΔLk, one line per Cs
+  timeseries.png      E_total, E_K (log), Wr and τ(t) against time: one column per ΔLk, one line
+                      per Cs
+  shapes.png          contact sheet: every run's final shape (rows ΔLk, columns Cs), its time,
+                      class and stop reason on the tile
 
-ΔLk and Cs come from each run's config.toml (rod.excess_link, solvent.salt_M); the writhe
-convergence and relaxation times from summary.json after `ibrod analyze` (with --ibrod BINARY the
-script runs `BINARY analyze` on runs not yet analysed and `BINARY render` on runs without a
-picture). Needs numpy and matplotlib; use /usr/bin/python3.
+ΔLk and Cs come from each run's config.toml (rod.excess_link, solvent.salt_M); the numbers from
+summary.json after `ibrod analyze` (with --ibrod BINARY the script runs `BINARY analyze` on every
+run first, with --frames `analyze --frames`, and `BINARY render` on runs without a picture). A
+quantity that presumes equilibrium (writhe convergence time, τ, limiting energies) is shown as
+"not finished" for a run whose stop_reason is not "equilibrium". Needs numpy and matplotlib; use
+/usr/bin/python3.
 """
 import argparse
 import csv
@@ -37,10 +40,11 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from ibrod_plot import Run, plot_runs  # noqa: E402
+from ibrod_plot import Run  # noqa: E402
 
 DASH = "—"
 NOT_ANALYSED = "not analysed"
+NOT_FINISHED = "not finished"
 
 
 def fmt(v, digits=3):
@@ -51,6 +55,15 @@ def fmt(v, digits=3):
             return DASH
         return f"{v:.{digits}g}"
     return str(v)
+
+
+def analysed(run):
+    return "equilibrium_reached" in run.summary
+
+
+def final(run, key):
+    ts = run.ts
+    return float(ts[key][-1]) if key in ts.dtype.names else None
 
 
 def final_picture(run, view):
@@ -88,9 +101,15 @@ def draw_final_state_3d(ax, run):
     ax.set_axis_off()
 
 
+def tile_caption(run):
+    shape = (run.summary.get("shape") or {}).get("class", DASH)
+    stop = run.summary.get("stop_reason", "?")
+    return f"t = {fmt(final(run, 'time_us'))} µs, {shape}, {stop}"
+
+
 def contact_sheet(grid, dlks, css, view, out):
     nr, nc = len(dlks), len(css)
-    fig = plt.figure(figsize=(2.6 * nc + 0.8, 2.6 * nr + 0.6))
+    fig = plt.figure(figsize=(3.0 * nc + 0.6, 3.4 * nr + 0.4))
     for i, dlk in enumerate(dlks):
         for j, cs in enumerate(css):
             runs = grid.get((dlk, cs), [])
@@ -113,57 +132,162 @@ def contact_sheet(grid, dlks, css, view, out):
             if len(runs) > 1:
                 title += f" (+{len(runs) - 1})"
             ax.set_title(title, fontsize="small")
+            if runs:  # text2D on a 3-D axes
+                put = ax.text2D if hasattr(ax, "text2D") else ax.text
+                put(0.5, -0.02, tile_caption(runs[0]), ha="center", va="top",
+                    fontsize="small", transform=ax.transAxes)
     fig.tight_layout()
-    fig.savefig(out, dpi=100)
+    fig.savefig(out, dpi=80)
     plt.close(fig)
 
 
-def final(run, key):
-    ts = run.ts
-    return float(ts[key][-1]) if key in ts.dtype.names else None
+def relaxed_circle_electro(grid, cs):
+    """E_electro of a run at salt cs that stays circular and reached equilibrium, or None."""
+    for (dlk, c), runs in sorted(grid.items()):
+        for r in runs:
+            if c == cs and r.summary.get("stays_circular") and r.finished:
+                return final(r, "E_electro_kT")
+    return None
 
 
 def against_excess_link(grid, dlks, css, out):
+    """Final-state quantities against ΔLk; hollow markers: runs that did not finish."""
     panels = [
-        ("total energy (kT)", lambda r: final(r, "E_total_kT")),
-        ("bend + twist energy (kT)",
-         lambda r: final(r, "E_bend_kT") + final(r, "E_twist_kT")),
-        ("writhe", lambda r: final(r, "writhe")),
-        ("closest approach (Å)", lambda r: final(r, "closest_approach_A")),
+        ("E_bend (kT)", lambda r, cs: final(r, "E_bend_kT")),
+        ("E_twist (kT)", lambda r, cs: final(r, "E_twist_kT")),
+        ("ΔE_electro (kT), vs the initial circle", lambda r, cs: final(r, "dE_electro_kT")),
+        ("ΔE_electro (kT), vs the relaxed circle",
+         lambda r, cs: (None if relaxed_circle_electro(grid, cs) is None
+                        else final(r, "E_electro_kT") - relaxed_circle_electro(grid, cs))),
+        ("writhe", lambda r, cs: final(r, "writhe")),
+        ("closest approach (Å)", lambda r, cs: final(r, "closest_approach_A")),
     ]
-    fig, axes = plt.subplots(2, 2, figsize=(10, 7.5), constrained_layout=True)
+    fig, axes = plt.subplots(2, 3, figsize=(12, 6.5), constrained_layout=True)
+    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for ax, (ylabel, value) in zip(axes.flat, panels):
-        for cs in css:
-            xs, ys = [], []
+        for k, cs in enumerate(css):
+            c = colors[k % len(colors)]
+            xs, ys, done = [], [], []
             for dlk in dlks:
                 for run in grid.get((dlk, cs), []):
-                    v = value(run)
+                    v = value(run, cs)
                     if v is not None and np.isfinite(v):
                         xs.append(dlk)
                         ys.append(v)
-            if xs:
-                ax.plot(xs, ys, "o-", label=f"Cs = {cs:g} M")
+                        done.append(run.finished is True)
+            if not xs:
+                continue
+            ax.plot(xs, ys, "-", color=c, label=f"Cs = {cs:g} M")
+            for x, y, d in zip(xs, ys, done):
+                ax.plot([x], [y], "o", color=c, mfc=c if d else "none")
+        if not any(ax.get_lines()):
+            ax.text(0.5, 0.5, "no run that stays circular\nand reached equilibrium",
+                    ha="center", va="center", transform=ax.transAxes, fontsize="small")
         ax.set_xlabel("ΔLk")
         ax.set_ylabel(ylabel)
         ax.set_xticks(dlks)
         ax.grid(True, alpha=0.3)
-    axes.flat[0].legend(fontsize="small")
-    fig.savefig(out, dpi=110)
+    axes.flat[0].legend(fontsize="small", title="hollow: not finished", title_fontsize="x-small")
+    fig.savefig(out, dpi=80)
+    plt.close(fig)
+
+
+def timeseries_panels(grid, dlks, css, out):
+    """Rows E_total, E_K (log), Wr, τ(t); one column per ΔLk, one line per Cs."""
+    nc = len(dlks)
+    fig, axes = plt.subplots(4, nc, figsize=(3.6 * nc + 0.6, 9), sharex="col", squeeze=False,
+                             constrained_layout=True)
+    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for j, dlk in enumerate(dlks):
+        ax_e, ax_k, ax_w, ax_t = axes[:, j]
+        for k, cs in enumerate(css):
+            for run in grid.get((dlk, cs), []):
+                c = colors[k % len(colors)]
+                t = run.ts["time_us"]
+                lab = f"Cs = {cs:g} M" + ("" if run.finished is not False else f" ({NOT_FINISHED})")
+                ax_e.plot(t, run.ts["E_total_kT"], color=c, label=lab)
+                ek = run.ts["E_kinetic_kT"]
+                ax_k.plot(t[ek > 0], ek[ek > 0], color=c)
+                ax_w.plot(t, run.ts["writhe"], color=c)
+                loc = [w for w in run.summary.get("relaxation_time_local_us") or [] if w["tau_us"] > 0]
+                if loc:
+                    ax_t.plot([0.5 * (w["t_start_us"] + w["t_end_us"]) for w in loc],
+                              [w["tau_us"] for w in loc], "o-", color=c, markersize=3)
+                settled = run.summary.get("contacts_settled_time_us")
+                if settled is not None:
+                    ax_k.axvline(settled, color=c, linestyle=":", linewidth=1)
+        ax_e.set_title(f"ΔLk = {dlk}")
+        ax_k.set_yscale("log")
+        ax_t.set_xlabel("time (µs)")
+        ax_e.legend(fontsize="x-small")
+        for ax in axes[:, j]:
+            ax.grid(True, alpha=0.3)
+    axes[0, 0].set_ylabel("E_total (kT)")
+    axes[1, 0].set_ylabel("E_K (kT); dotted: contacts settle")
+    axes[2, 0].set_ylabel("writhe")
+    axes[3, 0].set_ylabel("τ(t) (µs)")
+    fig.savefig(out, dpi=80)
     plt.close(fig)
 
 
 def table(grid, dlks, css, cell):
     head = "| ΔLk | " + " | ".join(f"Cs = {cs:g} M" for cs in css) + " |"
-    rule = "|---|" + "---|" * len(css)
-    rows = [head, rule]
+    rows = [head, "|---|" + "---|" * len(css)]
     for dlk in dlks:
         cells = []
         for cs in css:
             runs = grid.get((dlk, cs), [])
-            cells.append("<br>".join(cell(r) if "writhe_convergence_time_us" in r.summary
-                                     else NOT_ANALYSED for r in runs) if runs else DASH)
+            cells.append("<br>".join(cell(r) if analysed(r) else NOT_ANALYSED for r in runs)
+                         if runs else DASH)
         rows.append(f"| {dlk} | " + " | ".join(cells) + " |")
     return "\n".join(rows)
+
+
+def needs_equilibrium(cell):
+    """A table cell of a quantity that presumes equilibrium: "not finished" otherwise."""
+    return lambda r: cell(r) if r.finished else NOT_FINISHED
+
+
+def writhe_cell(r):
+    return fmt(r.summary.get("writhe_convergence_time_us"))
+
+
+def tau_cell(r):
+    s = r.summary
+    tau = s.get("relaxation_time_table_us")
+    if tau is None:
+        return s.get("relaxation_contacts_note") or DASH
+    if s.get("relaxation_time_method") == "after_last_contact":
+        fit = s.get("relaxation_contacts_fit") or {}
+        return f"{fmt(tau)} (R² {fmt(fit.get('r2'), 3)})"
+    fit = s.get("relaxation_fit") or {}
+    return f"{fmt(tau)}† (R² {fmt(fit.get('r2'), 3)})"
+
+
+def shape_cell(r):
+    sh = r.summary.get("shape") or {}
+    cls = sh.get("class", DASH)
+    if sh.get("class") == "plectonemic":
+        cls += f", two-ply {fmt(sh.get('interwound_length_A'))} Å"
+    return (f"{cls}, {fmt(sh.get('loops'))} loops, Wr {fmt(final(r, 'writhe'), 3)}, "
+            f"{fmt(final(r, 'closest_approach_A'), 3)} Å")
+
+
+def transients_cell(r):
+    tr = r.summary.get("transients")
+    if tr is None:
+        return DASH
+    if not tr:
+        return "none"
+    frames = r.summary.get("shape_frames") or []
+
+    def named(t):  # the class of the frame nearest to the transient (with --frames)
+        if not frames:
+            return ""
+        f = min(frames, key=lambda f: abs(f["time_us"] - t))
+        return f", {f['class']}"
+    return "; ".join(f"{fmt(x['time_us'])} µs, {fmt(x['E_total_kT'], 5)} kT{named(x['time_us'])}"
+                     for x in tr)
 
 
 def maybe_run(binary, args):
@@ -173,26 +297,50 @@ def maybe_run(binary, args):
               file=sys.stderr)
 
 
+def write_runs_csv(runs, path):
+    fields = ["run", "excess_link", "salt_M", "stop_reason", "equilibrium_reached", "time_us",
+              "writhe", "twist", "E_bend_kT", "E_twist_kT", "dE_electro_kT", "E_total_kT",
+              "E_kinetic_kT", "closest_approach_A", "shape", "loops", "crossings",
+              "interwound_length_A", "writhe_convergence_time_us", "relaxation_time_table_us",
+              "relaxation_time_method", "relaxation_time_us", "relaxation_time_contacts_us",
+              "transients", "kinetic_power_law_exponent"]
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(fields)
+        for r in runs:
+            s, sh = r.summary, r.summary.get("shape") or {}
+            tr = s.get("transients")
+            w.writerow([r.path, r.excess_link, r.salt_M, s.get("stop_reason"),
+                        s.get("equilibrium_reached"), final(r, "time_us"), final(r, "writhe"),
+                        final(r, "twist"), final(r, "E_bend_kT"), final(r, "E_twist_kT"),
+                        final(r, "dE_electro_kT"), final(r, "E_total_kT"), final(r, "E_kinetic_kT"),
+                        final(r, "closest_approach_A"), sh.get("class"), sh.get("loops"),
+                        sh.get("crossings"), sh.get("interwound_length_A"),
+                        s.get("writhe_convergence_time_us"), s.get("relaxation_time_table_us"),
+                        s.get("relaxation_time_method"), s.get("relaxation_time_us"),
+                        s.get("relaxation_time_contacts_us"),
+                        len(tr) if tr is not None else None, s.get("kinetic_power_law_exponent")])
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("runs", nargs="+", metavar="RUN_DIR", help="output directories of ibrod run")
     p.add_argument("-o", "--output", required=True, metavar="REPORT_DIR", help="directory to write")
     p.add_argument("--view", default="oblique", help="which rendered view goes into the contact sheet")
     p.add_argument("--ibrod", metavar="BINARY",
-                   help="ibrod binary: analyse and render the runs that lack it first")
+                   help="ibrod binary: analyse every run and render those without a picture first")
+    p.add_argument("--frames", action="store_true",
+                   help="with --ibrod: `analyze --frames` (the shape of every frame names transients)")
+    p.add_argument("--tau-window", metavar="US",
+                   help="with --ibrod: `analyze --tau-window US` (windows of τ(t), µs; default 1)")
     a = p.parse_args(argv)
 
     if a.ibrod:
         for d in a.runs:
-            sp = os.path.join(d, "summary.json")
-            analysed = False
-            if os.path.isfile(sp):
-                with open(sp) as f:
-                    analysed = '"writhe_convergence_time_us"' in f.read()
-            if not analysed:
-                maybe_run(a.ibrod, ["analyze", "--quiet", d])
+            maybe_run(a.ibrod, ["analyze", "--quiet", d] + (["--frames"] if a.frames else []) +
+                      (["--tau-window", a.tau_window] if a.tau_window else []))
             if not glob.glob(os.path.join(d, "render", f"rod_{a.view}_t*.png")):
-                maybe_run(a.ibrod, ["render", d, "--views", a.view, "--size", "400x400"])
+                maybe_run(a.ibrod, ["render", d, "--views", a.view, "--size", "300x300"])
 
     runs = [Run(d) for d in a.runs]
     os.makedirs(a.output, exist_ok=True)
@@ -208,81 +356,59 @@ def main(argv=None):
 
     figures = []
     if grid:
-        contact_sheet(grid, dlks, css, a.view, os.path.join(a.output, "shapes.png"))
         against_excess_link(grid, dlks, css, os.path.join(a.output, "vs_excess_link.png"))
-        figures += [("Final shapes (rows ΔLk, columns Cs)", "shapes.png"),
-                    ("Final energies, writhe and closest approach against ΔLk", "vs_excess_link.png")]
-        for cs in css:
-            members = [r for dlk in dlks for r in grid.get((dlk, cs), [])]
-            name = f"timeseries_Cs{cs:g}.png"
-            plot_runs(members, os.path.join(a.output, name), title=f"Cs = {cs:g} M")
-            figures.append((f"Energy, kinetic energy and writhe against time, Cs = {cs:g} M", name))
+        timeseries_panels(grid, dlks, css, os.path.join(a.output, "timeseries.png"))
+        contact_sheet(grid, dlks, css, a.view, os.path.join(a.output, "shapes.png"))
+        figures = [
+            ("Final state against ΔLk", "vs_excess_link.png",
+             "E_bend, E_twist, the electrostatic energy relative to the initial circle at the same "
+             "Cs (`dE_electro_kT`) and relative to the relaxed circle at the same Cs (the final "
+             "state of a run of the sweep at that Cs that stays circular and reached equilibrium; "
+             "empty when there is none), writhe and closest approach. Hollow markers: runs that "
+             "did not reach equilibrium (their last state, not a limit)."),
+            ("Energy, kinetic energy, writhe and τ(t) against time", "timeseries.png",
+             "One column per ΔLk, one line per Cs. τ(t) = −2/(d ln E_K/dt) on windows of "
+             "`relaxation_time_local_window_us`; dotted: the contacts stop changing."),
+            ("Contact sheet", "shapes.png",
+             "Every run (rows ΔLk, columns Cs): time of the state, shape class and stop reason."),
+        ]
+    write_runs_csv(runs, os.path.join(a.output, "runs.csv"))
 
-    # runs.csv
-    fields = ["run", "excess_link", "salt_M", "stop_reason", "time_us", "writhe", "twist",
-              "E_total_kT", "E_kinetic_kT", "closest_approach_A", "writhe_convergence_time_us",
-              "relaxation_time_us", "relaxation_fit_r2", "transients", "kinetic_power_law_exponent"]
-    with open(os.path.join(a.output, "runs.csv"), "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(fields)
-        for r in runs:
-            s = r.summary
-            fit = s.get("relaxation_fit") or {}
-            tr = s.get("transients")
-            w.writerow([r.path, r.excess_link, r.salt_M, s.get("stop_reason"), final(r, "time_us"),
-                        final(r, "writhe"), final(r, "twist"), final(r, "E_total_kT"),
-                        final(r, "E_kinetic_kT"), final(r, "closest_approach_A"),
-                        s.get("writhe_convergence_time_us"), s.get("relaxation_time_us"),
-                        fit.get("r2"), len(tr) if tr is not None else None,
-                        s.get("kinetic_power_law_exponent")])
-
-    # report.md
-    unanalysed = [r.path for r in runs if "writhe_convergence_time_us" not in r.summary]
-
-    def tau_cell(r):
-        s = r.summary
-        tau = s.get("relaxation_time_us")
-        if tau is None:
-            return DASH
-        fit = s.get("relaxation_fit") or {}
-        star = "" if s.get("stop_reason") == "equilibrium" else "*"
-        return f"{fmt(tau)}{star} (R² {fmt(fit.get('r2'), 4)})"
-
-    def transients_cell(r):
-        tr = r.summary.get("transients")
-        if tr is None:
-            return DASH
-        if not tr:
-            return "none"
-        return "; ".join(f"{fmt(x['time_us'])} µs, {fmt(x['E_total_kT'], 5)} kT" for x in tr)
-
+    unanalysed = [r.path for r in runs if not analysed(r)]
     md = ["# ibrod sweep report", ""]
     md.append(f"{len(runs)} runs. ΔLk = {', '.join(map(str, dlks)) or DASH}; "
-              f"Cs = {', '.join(f'{c:g}' for c in css) or DASH} M.")
-    md.append("")
-    md.append("| run | ΔLk | Cs (M) | stop | t (µs) | Wr | closest approach (Å) | E_total (kT) |")
-    md.append("|---|---|---|---|---|---|---|---|")
+              f"Cs = {', '.join(f'{c:g}' for c in css) or DASH} M. "
+              f"\"{NOT_FINISHED}\": the run stopped before reaching equilibrium (summary.json "
+              "stop_reason is not \"equilibrium\"), so a number that presumes one is not given.")
+    md += ["", "| run | ΔLk | Cs (M) | stop | t (µs) | Wr | closest approach (Å) | E_total (kT) | shape |",
+           "|---|---|---|---|---|---|---|---|---|"]
     for r in runs:
         md.append(f"| {r.name} | {fmt(r.excess_link)} | {fmt(r.salt_M)} | "
                   f"{r.summary.get('stop_reason', DASH)} | {fmt(final(r, 'time_us'))} | "
                   f"{fmt(final(r, 'writhe'), 4)} | {fmt(final(r, 'closest_approach_A'), 4)} | "
-                  f"{fmt(final(r, 'E_total_kT'), 5)} |")
+                  f"{fmt(final(r, 'E_total_kT'), 5)} | "
+                  f"{(r.summary.get('shape') or {}).get('class', DASH)} |")
     md += ["", "## Writhe convergence time (µs)", "",
            "Largest t with |Wr(t) − Wr(∞)| > δ, Wr(∞) the final writhe (docs/analysis.md).", "",
-           table(grid, dlks, css, lambda r: fmt(r.summary.get("writhe_convergence_time_us"))),
+           table(grid, dlks, css, needs_equilibrium(writhe_cell)),
            "", "## Relaxation time τ (µs)", "",
-           "E_K ∝ exp(−2t/τ) fitted on the final approach; R² of the log-linear fit. "
-           "* the run stopped before reaching equilibrium (E_K above time.stop_kinetic_kT): τ "
-           "describes its last stretch only.", "",
-           table(grid, dlks, css, tau_cell),
+           "E_K ∝ exp(−2t/τ) fitted on every row after the set of contacts stops changing "
+           "(`relaxation_time_contacts_us`; R² of the log-linear fit). † no trajectory frames: the "
+           "final-window fit (`relaxation_time_us`) instead. τ(t) is in the time-series figure.", "",
+           table(grid, dlks, css, needs_equilibrium(tau_cell)),
+           "", "## Final shapes", "",
+           "Class (docs/analysis.md \"Shapes\"), terminal loops, writhe and closest approach of "
+           "the last state (of an unfinished run: where it stopped).", "",
+           table(grid, dlks, css, shape_cell),
            "", "## Transient states", "",
-           "Local minima of E_K on plateaus of the total energy: time and plateau energy.", "",
+           "Local minima of E_K on plateaus of the total energy: time, plateau energy and (with "
+           "`analyze --frames`) the shape class there.", "",
            table(grid, dlks, css, transients_cell), ""]
     if unanalysed:
         md += ["Not analysed (run `ibrod analyze DIR`, or pass `--ibrod BINARY`): " +
                ", ".join(unanalysed), ""]
-    for caption, name in figures:
-        md += [f"## {caption}", "", f"![{caption}]({name})", ""]
+    for caption, name, text in figures:
+        md += [f"## {caption}", "", text, "", f"![{caption}]({name})", ""]
     with open(os.path.join(a.output, "report.md"), "w") as f:
         f.write("\n".join(md))
     print(os.path.join(a.output, "report.md"))

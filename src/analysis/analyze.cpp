@@ -65,9 +65,11 @@ RunInfo read_run_info(const fs::path& dir) {
 
 // ---- analyze
 
-Analysis analyze_timeseries(const CsvTable& table, const AnalyzeOptions& opt) {
-  // rows in strictly increasing time: where time goes back (a run continued from an earlier
-  // checkpoint appends rows it had already written), the later rows win
+namespace {
+
+/// The rows in strictly increasing time: where time goes back (a run continued from an earlier
+/// checkpoint appends rows it had already written), the later rows win.
+CsvTable increasing_rows(const CsvTable& table) {
   const auto time = table.column("time_us");
   std::vector<std::size_t> keep;
   for (std::size_t i = table.rows(); i-- > 0;)
@@ -80,7 +82,13 @@ Analysis analyze_timeseries(const CsvTable& table, const AnalyzeOptions& opt) {
     ts.columns.emplace_back();
     for (std::size_t i : keep) ts.columns.back().push_back(col[i]);
   }
+  return ts;
+}
 
+}  // namespace
+
+Analysis analyze_timeseries(const CsvTable& table, const AnalyzeOptions& opt) {
+  const CsvTable ts = increasing_rows(table);
   const std::size_t n = ts.rows();
   if (n < 2)
     throw ConfigError("'" + ts.path.string() + "' has " + std::to_string(n) +
@@ -101,6 +109,9 @@ Analysis analyze_timeseries(const CsvTable& table, const AnalyzeOptions& opt) {
     a.relaxation_time_us = fit->tau;
     a.relaxation_fit = fit_window(fit->line, t, opt.fit.tolerance);
   }
+  a.local_relaxation = diagnostics::local_relaxation_times(t, ek, opt.tau_window_us);
+  a.relaxation_time_table_us = a.relaxation_time_us;
+  a.relaxation_time_method = "final_window";
   for (const auto& s : diagnostics::transients(t, ek, et, opt.transients))
     a.transients.push_back({s.time, s.kinetic, s.total, wr[s.index], s.plateau_start, s.plateau_end});
 
@@ -125,14 +136,97 @@ Analysis analyze_timeseries(const CsvTable& table, const AnalyzeOptions& opt) {
   return a;
 }
 
+void add_contact_relaxation(Analysis& a, const CsvTable& table, ShapeAnalysis shapes,
+                            const AnalyzeOptions& opt) {
+  const CsvTable ts = increasing_rows(table);
+  const auto t = ts.column("time_us");
+  const auto ek = ts.column("E_kinetic_kT");
+  const ContactHistory& c = shapes.contacts;
+  if (c.time_us.empty()) {
+    a.relaxation_contacts_note = "contacts unknown: " + c.note +
+                                 "; the tables show the final-window τ (relaxation_time_us)";
+  } else {
+    const double settled = diagnostics::settled_time(c.time_us, c.clusters);
+    a.contacts_settled_time_us = settled;
+    if (const auto fit = diagnostics::relaxation_time_from(t, ek, settled, opt.fit.min_points)) {
+      a.relaxation_time_contacts_us = fit->tau;
+      FitWindow w;
+      w.t_start_us = t[fit->line.first];
+      w.t_end_us = t.back();
+      w.points = fit->line.count;
+      w.r2 = fit->line.r2;
+      w.max_abs_residual = fit->line.max_abs_residual;
+      w.within_tolerance = fit->line.max_abs_residual <= opt.fit.tolerance;
+      a.relaxation_contacts_fit = w;
+      a.relaxation_time_table_us = fit->tau;
+      a.relaxation_time_method = "after_last_contact";
+    } else {
+      a.relaxation_contacts_note = "E_K does not decay (or fewer than " +
+                                   std::to_string(opt.fit.min_points) +
+                                   " rows) after the contacts settled";
+      a.relaxation_time_table_us.reset();
+      a.relaxation_time_method = "after_last_contact";
+    }
+  }
+  a.shapes = std::move(shapes);
+}
+
+void require_equilibrium(Analysis& a, const std::string& stop_reason) {
+  a.checked = true;
+  a.stop_reason = stop_reason;
+  a.equilibrium = stop_reason == "equilibrium";
+  if (a.equilibrium) return;
+  a.not_finished_reason =
+      (stop_reason.empty() ? std::string("summary.json has no stop_reason")
+                           : "the run stopped by '" + stop_reason + "'") +
+      ", not at equilibrium (E_K < time.stop_kinetic_kT): the writhe convergence time, relaxation "
+      "times and limiting energies presume one";
+  a.writhe_convergence_time_us.reset();
+  a.relaxation_time_us.reset();
+  a.relaxation_fit.reset();
+  a.relaxation_time_contacts_us.reset();
+  a.relaxation_contacts_fit.reset();
+  a.relaxation_time_table_us.reset();
+  a.warnings.push_back("not finished: " + a.not_finished_reason + "; they are null");
+}
+
 namespace {
+
+json shape_json(const diagnostics::Shape& s, double time_us) {
+  return json{{"time_us", time_us},
+              {"class", diagnostics::shape_class_name(s.cls)},
+              {"crossings", s.crossings},
+              {"crossings_direction", {s.direction.x(), s.direction.y(), s.direction.z()}},
+              {"crossings_mode", s.crossings_mode},
+              {"lobes", s.lobes},
+              {"loops", s.loops},
+              {"interwound_length_A", s.interwound_length_A},
+              {"interwound_runs", s.interwound_runs},
+              {"contact_clusters", s.contact_clusters}};
+}
 
 json to_json(const Analysis& a, const AnalyzeOptions& opt) {
   json j;
   j["writhe_final"] = a.writhe_final;
-  j["writhe_convergence_time_us"] = a.writhe_convergence_time_us;
+  const json reason = a.not_finished_reason.empty() ? json(nullptr) : json(a.not_finished_reason);
+  j["equilibrium_reached"] = a.checked ? json(a.equilibrium) : json(nullptr);
+  j["not_finished_reason"] = reason;
+  j["writhe_convergence_time_us"] = optional_json(a.writhe_convergence_time_us);
   j["relaxation_time_us"] = optional_json(a.relaxation_time_us);
   j["relaxation_fit"] = fit_json(a.relaxation_fit);
+  j["contacts_settled_time_us"] = optional_json(a.contacts_settled_time_us);
+  j["relaxation_time_contacts_us"] = optional_json(a.relaxation_time_contacts_us);
+  j["relaxation_contacts_fit"] = fit_json(a.relaxation_contacts_fit);
+  j["relaxation_contacts_note"] =
+      a.relaxation_contacts_note.empty() ? json(nullptr) : json(a.relaxation_contacts_note);
+  j["relaxation_time_table_us"] = optional_json(a.relaxation_time_table_us);
+  j["relaxation_time_method"] = a.relaxation_time_method;
+  json local = json::array();
+  for (const auto& w : a.local_relaxation)
+    local.push_back(json{{"t_start_us", w.t_start}, {"t_end_us", w.t_end}, {"tau_us", w.tau},
+                         {"points", w.points}});
+  j["relaxation_time_local_us"] = local;
+  j["relaxation_time_local_window_us"] = opt.tau_window_us;
   json tr = json::array();
   for (const auto& s : a.transients)
     tr.push_back(json{{"time_us", s.time_us},
@@ -148,6 +242,29 @@ json to_json(const Analysis& a, const AnalyzeOptions& opt) {
   json e = json::object();
   for (const auto& [name, v] : a.final_energies_kT) e[name] = v;
   j["final_energies_kT"] = e;
+  j["limiting_energies_kT"] = a.equilibrium ? e : json(nullptr);
+  const ShapeAnalysis& sh = a.shapes;
+  j["shape"] = sh.final_shape ? shape_json(sh.final_shape->shape, sh.final_shape->time_us)
+                              : json(nullptr);
+  // null without --frames, so that an earlier analysis's frames do not outlive a new one
+  json fr = opt.every_frame ? json::array() : json(nullptr);
+  for (const auto& f : sh.frames) fr.push_back(shape_json(f.shape, f.time_us));
+  j["shape_frames"] = fr;
+  json contacts{{"distance_A", sh.contact_distance_A}};
+  if (sh.contacts.time_us.empty()) {
+    contacts["source"] = nullptr;
+    contacts["note"] = sh.contacts.note;
+  } else {
+    contacts["source"] = "trajectory.h5";
+    contacts["frames"] = sh.contacts.time_us.size();
+    json changes = json::array();
+    for (std::size_t i = 1; i < sh.contacts.time_us.size(); ++i)
+      if (sh.contacts.clusters[i] != sh.contacts.clusters[i - 1])
+        changes.push_back(json{{"time_us", sh.contacts.time_us[i]}, {"clusters", sh.contacts.clusters[i]}});
+    contacts["initial_clusters"] = sh.contacts.clusters.front();
+    contacts["changes"] = changes;
+  }
+  j["contacts"] = contacts;
   j["stays_circular"] = a.stays_circular;
   j["kinetic_power_law_exponent"] = optional_json(a.kinetic_power_law_exponent);
   j["kinetic_power_law_fit"] = fit_json(a.kinetic_power_law_fit);
@@ -158,7 +275,9 @@ json to_json(const Analysis& a, const AnalyzeOptions& opt) {
                        {"fit_tolerance_ln", opt.fit.tolerance},
                        {"fit_min_points", opt.fit.min_points},
                        {"transient_min_rise", opt.transients.min_rise},
-                       {"transient_plateau_fraction", opt.transients.plateau_fraction}};
+                       {"transient_plateau_fraction", opt.transients.plateau_fraction},
+                       {"contact_distance_A", a.shapes.contact_distance_A},
+                       {"every_frame", opt.every_frame}};
   return j;
 }
 
@@ -170,7 +289,12 @@ std::string analysis_json(const Analysis& a, const AnalyzeOptions& opt) {
 
 Analysis analyze_run(const fs::path& dir, const AnalyzeOptions& opt) {
   if (!fs::is_directory(dir)) throw ConfigError("'" + dir.string() + "' is not a directory");
-  const Analysis a = analyze_timeseries(read_csv_table(RunDir(dir).timeseries()), opt);
+  const CsvTable table = read_csv_table(RunDir(dir).timeseries());
+  Analysis a = analyze_timeseries(table, opt);
+  const RunInfo info = read_run_info(dir);
+  const double dc = opt.contact_distance_A > 0 ? opt.contact_distance_A
+                                                : default_contact_distance(info.diameter_A, info.salt_M);
+  add_contact_relaxation(a, table, analyze_shapes(dir, dc, opt.every_frame), opt);
   const fs::path sp = RunDir(dir).summary();
   json summary = json::object();
   if (fs::exists(sp)) {
@@ -181,6 +305,10 @@ Analysis analyze_run(const fs::path& dir, const AnalyzeOptions& opt) {
     }
     if (!summary.is_object()) throw ConfigError("'" + sp.string() + "' is not a JSON object");
   }
+  std::string stop_reason;
+  if (summary.contains("stop_reason") && summary["stop_reason"].is_string())
+    stop_reason = summary["stop_reason"].get<std::string>();
+  require_equilibrium(a, stop_reason);
   const json added = to_json(a, opt);
   for (const auto& [k, v] : added.items()) summary[k] = v;
   write_file_atomic(sp, summary.dump(4) + "\n");

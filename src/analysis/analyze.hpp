@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/types.hpp"
+#include "analysis/shapes.hpp"
 #include "diagnostics/relaxation.hpp"
 #include "io/csv.hpp"
 
@@ -37,6 +38,9 @@ struct AnalyzeOptions {
   double circular_writhe = 0.05;        ///< a run "stays circular" while |Wr| < this throughout
   diagnostics::WindowOptions fit;              ///< final-window fits (ln E_K; tolerance in ln units)
   diagnostics::TransientOptions transients;
+  double contact_distance_A = 0;  ///< d_c of contacts and plies; 0: D + 3 λ_D of config.toml
+  bool every_frame = false;       ///< `--frames`: the shape of every frame of trajectory.h5
+  double tau_window_us = 1.0;     ///< width of the windows of τ(t)
 };
 
 /// The window and quality of a final-window fit (diagnostics::fit_final_linear_window).
@@ -57,10 +61,27 @@ struct TransientState {
 /// The analysis of one time series; each field is the summary.json key of the same name.
 struct Analysis {
   std::size_t rows = 0;
+  // did the run reach equilibrium (summary.json stop_reason == "equilibrium")? Set by
+  // require_equilibrium; analyze_timeseries alone leaves `checked` false
+  bool checked = false;
+  bool equilibrium = false;
+  std::string stop_reason;          ///< summary.json's, "" when unknown
+  std::string not_finished_reason;  ///< why the equilibrium quantities are null ("" if they are not)
+  std::vector<std::string> warnings;
   double writhe_final = 0;
-  double writhe_convergence_time_us = 0;
-  std::optional<double> relaxation_time_us;  ///< τ of E_K ∝ exp(−2t/τ); none if E_K does not decay
+  std::optional<double> writhe_convergence_time_us;  ///< null for an unfinished run
+  std::optional<double> relaxation_time_us;  ///< τ of E_K ∝ exp(−2t/τ) on the final tolerance
+                                             ///< window; none if E_K does not decay
   std::optional<FitWindow> relaxation_fit;
+  // τ after the last contact formed (docs/analysis.md): contacts from trajectory.h5
+  std::optional<double> contacts_settled_time_us;
+  std::optional<double> relaxation_time_contacts_us;
+  std::optional<FitWindow> relaxation_contacts_fit;
+  std::string relaxation_contacts_note;  ///< why it is null ("" when it is not)
+  std::optional<double> relaxation_time_table_us;  ///< the τ the report's tables show
+  std::string relaxation_time_method;    ///< which: "after_last_contact" or "final_window"
+  std::vector<diagnostics::LocalRelaxation> local_relaxation;  ///< τ(t), windows in µs
+  ShapeAnalysis shapes;                  ///< filled by analyze_run
   std::vector<TransientState> transients;
   double closest_approach_A = 0;             ///< at the last row
   double closest_approach_min_A = 0;         ///< over the run
@@ -76,6 +97,18 @@ struct Analysis {
 /// time is not below that of every later row (a continued run that rewrote a stretch) are
 /// dropped: the later rows win.
 Analysis analyze_timeseries(const CsvTable& table, const AnalyzeOptions& opt = {});
+
+/// Adds the contact-based relaxation time and τ(t) to `a` from the time series and the contact
+/// history `shapes.contacts` (stored in a.shapes): τ fitted on every row from the first frame
+/// after the last change of the number of contact clusters; without a history, a note and the
+/// final-window τ as the table's number.
+void add_contact_relaxation(Analysis& a, const CsvTable& table, ShapeAnalysis shapes,
+                            const AnalyzeOptions& opt = {});
+
+/// The honest part (issue 15 item 4): with stop_reason other than "equilibrium" every quantity
+/// that presumes equilibrium (writhe convergence time, relaxation times, limiting energies) is
+/// set to none, `not_finished_reason` says why and a warning is added.
+void require_equilibrium(Analysis& a, const std::string& stop_reason);
 
 /// The analysis as the JSON object of keys `ibrod analyze` adds to summary.json:
 /// writhe_final, writhe_convergence_time_us, relaxation_time_us, relaxation_fit, transients,

@@ -32,6 +32,11 @@ struct Config {
   double time_dt_ns = 0.1;         ///< time.dt_ns: Δt, ns
   double time_t_end_us = 0.5;      ///< time.t_end_us: simulated time, µs
   double time_stop_kinetic_kT = 1e-12;  ///< time.stop_kinetic_kT: stop when E_K below, kT (0: never)
+  bool time_stability_test = true;         ///< test a state before calling it an equilibrium
+  double time_stability_amplitude_rad = 0.05;  ///< twist perturbation of the test, rad
+  double time_stability_probe_us = 0.5;        ///< how long the perturbed copy is integrated, µs
+  double time_stability_tolerance_kT = 1e-3;   ///< an energy drop beyond this: unstable, kT
+  std::int64_t time_stability_seed = 1;        ///< seed of the test's perturbation
   std::string time_scheme = "explicit";  ///< time.scheme: "explicit" | "implicit" (issue 14)
   double time_max_displacement_A = 0;    ///< implicit: largest point move per step, Å (0: auto)
   double time_energy_tolerance_kT = 1e-6;  ///< implicit: allowed energy rise per step, kT
@@ -40,11 +45,6 @@ struct Config {
   int time_implicit_jacobian_every = 1;      ///< implicit: steps between stiffness refreshes
   int time_implicit_krylov_iterations = 0;   ///< implicit: GMRES iterations (0: IMEX)
   double time_implicit_krylov_tol = 1e-2;    ///< implicit: GMRES relative residual
-  bool time_stability_test = true;         ///< test a state before calling it an equilibrium
-  double time_stability_amplitude_rad = 0.05;  ///< twist perturbation of the test, rad
-  double time_stability_probe_us = 0.5;        ///< how long the perturbed copy is integrated, µs
-  double time_stability_tolerance_kT = 1e-3;   ///< an energy drop beyond this: unstable, kT
-  std::int64_t time_stability_seed = 1;        ///< seed of the test's perturbation
   // [rod]
   int rod_base_pairs = 600;        ///< rod.base_pairs: rod points n
   int rod_excess_link = 6;         ///< rod.excess_link: ΔLk (integer)
@@ -116,6 +116,10 @@ bool only_end_time_extended(const std::string& old_toml, const Config& now,
 
 /// Convert to internal units (g, Å, s) for the simulation.
 sim::SimParams to_params(const Config& c);
+
+/// What `ibrod check` warns of (the run is allowed): a grid spacing larger than the hard core,
+/// a box that leaves the ring's periodic images within a few Debye lengths. One sentence each.
+std::vector<std::string> check_warnings(const Config& c);
 
 /// Derived quantities for `ibrod check`: h, c, Δs, r0, 1/κ, Bjerrum length, steps, memory.
 std::string derived_report(const Config& c);

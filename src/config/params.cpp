@@ -1,6 +1,8 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "config/config.hpp"
 #include "config/detail.hpp"
@@ -205,5 +207,24 @@ std::string derived_report(const Config& c) {
   return os.str();
 }
 
+std::vector<std::string> check_warnings(const Config& c) {
+  std::vector<std::string> w;
+  const auto p = to_params(c);
+  const double h = p.stepper.grid.h();
+  if (c.steric_enabled && h > c.steric_diameter_A)
+    w.push_back("the grid spacing h = " + fmt(h) + " Å (grid.box_A / grid.n) exceeds the hard-core "
+                "diameter steric.diameter_A = " + fmt(c.steric_diameter_A) +
+                " Å: the fluid cannot resolve strands in contact (raise grid.n)");
+  const double r0 = rod::circle_radius(c.rod_base_pairs, c.rod_rise_A);
+  const double kappa = p.stepper.electro.law.kappa;
+  if (c.electrostatics_enabled && kappa > 0) {
+    const double need = 2 * r0 + c.steric_diameter_A + 3.0 / kappa;
+    if (c.grid_box_A < need)
+      w.push_back("the box grid.box_A = " + fmt(c.grid_box_A) + " Å leaves less than 3 Debye "
+                  "lengths (3/κ = " + fmt(3.0 / kappa) + " Å) between the ring (diameter " +
+                  fmt(2 * r0) + " Å) and its periodic images: they interact (raise grid.box_A)");
+  }
+  return w;
+}
 
 }  // namespace ibrod::config

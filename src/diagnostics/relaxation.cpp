@@ -142,6 +142,64 @@ std::optional<ExponentialFit> relaxation_time(std::span<const double> t,
   return e;
 }
 
+std::optional<ExponentialFit> relaxation_time_from(std::span<const double> t,
+                                                   std::span<const double> kinetic,
+                                                   double t_start, std::size_t min_points) {
+  require_same_size(t, kinetic, "relaxation_time_from");
+  std::vector<double> x, y;
+  std::size_t first = t.size();
+  for (std::size_t i = 0; i < t.size(); ++i)
+    if (t[i] >= t_start && kinetic[i] > 0 && std::isfinite(kinetic[i])) {
+      if (x.empty()) first = i;
+      x.push_back(t[i]);
+      y.push_back(std::log(kinetic[i]));
+    }
+  if (x.size() < std::max<std::size_t>(min_points, 2)) return std::nullopt;
+  const LineFit f = fit_line(x, y);
+  if (!(f.slope < 0)) return std::nullopt;
+  ExponentialFit e;
+  e.line = f;
+  e.line.first = first;  // the window's first sample (E_K = 0 samples inside are skipped)
+  e.tau = -2.0 / f.slope;
+  return e;
+}
+
+std::vector<LocalRelaxation> local_relaxation_times(std::span<const double> t,
+                                                    std::span<const double> kinetic,
+                                                    double width) {
+  require_same_size(t, kinetic, "local_relaxation_times");
+  if (!(width > 0)) throw std::invalid_argument("local_relaxation_times: width must be positive");
+  std::vector<LocalRelaxation> out;
+  if (t.empty()) return out;
+  const double t0 = t.front();
+  // samples grouped by their window index (computed once per sample, so rounding at a window's
+  // edge cannot stall the loop)
+  auto window_of = [&](std::size_t j) { return std::floor((t[j] - t0) / width); };
+  std::size_t i = 0;
+  while (i < t.size()) {
+    const double k = window_of(i);
+    const double a = t0 + k * width, b = a + width;
+    std::vector<double> x, y;
+    for (; i < t.size() && window_of(i) == k; ++i)
+      if (kinetic[i] > 0 && std::isfinite(kinetic[i])) {
+        x.push_back(t[i]);
+        y.push_back(std::log(kinetic[i]));
+      }
+    if (x.size() < 3 || x.back() == x.front()) continue;
+    const LineFit f = fit_line(x, y);
+    if (f.slope != 0) out.push_back({a, b, -2.0 / f.slope, x.size()});
+  }
+  return out;
+}
+
+double settled_time(std::span<const double> t, std::span<const int> count) {
+  if (t.size() != count.size() || t.empty())
+    throw std::invalid_argument("settled_time: t and count must be the same size, not empty");
+  for (std::size_t i = t.size() - 1; i > 0; --i)
+    if (count[i] != count[i - 1]) return t[i];
+  return t.front();
+}
+
 std::optional<PowerLawFit> power_law_exponent(std::span<const double> t,
                                               std::span<const double> kinetic,
                                               const WindowOptions& opt) {

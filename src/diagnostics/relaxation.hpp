@@ -65,6 +65,30 @@ std::optional<ExponentialFit> relaxation_time(std::span<const double> t,
                                               std::span<const double> kinetic,
                                               const WindowOptions& opt = {});
 
+/// τ of E_K ∝ exp(−2t/τ) fitted (least squares in ln E_K) on every sample with t ≥ t_start and
+/// E_K > 0 — the approach after the last contact formed (docs/analysis.md). nullopt with fewer
+/// than min_points such samples or when E_K does not decay there (slope ≥ 0).
+std::optional<ExponentialFit> relaxation_time_from(std::span<const double> t,
+                                                   std::span<const double> kinetic,
+                                                   double t_start, std::size_t min_points = 5);
+
+/// τ(t) = −2 / (d ln E_K / dt) over one window of the series.
+struct LocalRelaxation {
+  double t_start = 0, t_end = 0;  ///< the window [t_start, t_end), t's unit
+  double tau = 0;                 ///< −2/slope of ln E_K there; negative where E_K grows
+  std::size_t points = 0;
+};
+
+/// τ(t) on consecutive windows [t_0 + k·width, t_0 + (k+1)·width) that hold at least 3 samples
+/// with E_K > 0 (others are skipped); slope 0 (flat E_K) gives no entry. width > 0.
+std::vector<LocalRelaxation> local_relaxation_times(std::span<const double> t,
+                                                    std::span<const double> kinetic,
+                                                    double width);
+
+/// When a sampled count stops changing: the time of the first sample after its last change,
+/// t.front() if it never changes. t and count the same size, not empty.
+double settled_time(std::span<const double> t, std::span<const int> count);
+
 /// Exponent p of E_K ∝ t^p (p < 0 for a decay), fitted as ln E_K against ln t on the longest final
 /// window where that is a line to opt.tolerance, within the final run of samples with t > 0 and
 /// E_K > 0. nullopt when fewer than opt.min_points such samples.

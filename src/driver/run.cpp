@@ -2,38 +2,28 @@
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
-#include <optional>
 #include <stdexcept>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "core/error.hpp"
-#include "core/text_file.hpp"
-#include "driver/mpi_env.hpp"
-#include "driver/progress.hpp"
-#include "driver/run_files.hpp"
-#include "driver/signals.hpp"
+#include "driver/run_state.hpp"
 #include "fluid/distributed_fluid.hpp"
 #include "fluid/fftw_wisdom.hpp"
 #include "io/atomic_file.hpp"
-#include "io/checkpoint.hpp"
 #include "io/csv.hpp"
 #include "io/npy.hpp"
-#include "io/run_dir.hpp"
 #include "sim/rod_problem.hpp"
 #include "sim/stability.hpp"
 
 namespace ibrod::driver {
 
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
-using sim::StopReason;
 
 namespace {
 
@@ -52,97 +42,7 @@ std::string format_g(double v, int digits = 6) {
   return buf;
 }
 
-double seconds_since(Clock::time_point t) {
-  return std::chrono::duration<double>(Clock::now() - t).count();
-}
-
-/// A run that has already stopped, resumed without a change: nothing to do.
-struct AlreadyFinished {};
-
 }  // namespace
-
-// Everything one run holds between its steps. Under MPI (ranks > 1) rank 0 alone writes (files
-// is null elsewhere); every write goes through on_root so that a failure there stops every rank.
-struct Run::State {
-  config::Config user;   // as given (config.toml is written from it)
-  config::Config c;      // as run (threads resolved on resume)
-  RunOptions opt;
-  io::RunDir dir;
-  std::string config_text;
-  Clock::time_point t0 = Clock::now();
-  bool distributed = false;
-  Progress progress;
-  std::optional<DirLock> lock;               // rank 0: held while the run writes dir
-
-  std::optional<io::Checkpoint> checkpoint;  // the one to continue from, until it is applied
-  bool config_changed = false;
-  bool extension = false;  // --resume with a later time.t_end_us alone
-  // a run that stopped but was killed before its final files were all written: --resume only
-  // writes them (the reason it stopped, from the checkpoint)
-  bool complete_only = false;
-  StopReason stopped_reason = StopReason::none;
-  std::optional<sim::Simulation> sim;
-  std::unique_ptr<RunFiles> files;           // rank 0 only
-  std::vector<double> gathered;              // distributed: the whole velocity on rank 0
-  io::CheckpointMeta meta;
-  RunResult result;
-  double wall_before = 0;                    // wall time of the earlier segments, s
-  Clock::time_point loop_start;
-  std::int64_t start_step = 0;
-  std::uintmax_t reserve_bytes = 0;
-  sim::Observables last_row;                 // the row of the latest output step
-
-  State(const config::Config& cfg, const RunOptions& o)
-      : user(cfg),
-        c(cfg),
-        opt(o),
-        dir(o.output_dir),
-        config_text(config::to_toml(cfg)),
-        distributed(o.ranks > 1),
-        progress(o.rank == 0 ? o.log : nullptr, o.tty) {}
-
-  void say(const std::string& s) { progress.message(s); }
-  void on_root(const std::function<void()>& f) { mpi::on_root(opt.rank, opt.ranks, f); }
-
-  void check_launch() const;
-  void open_checkpoint();
-  void prepare_directory();
-  void build_simulation();
-  void restore_state();
-  void open_files();
-  void announce();
-
-  double ms_per_step() const {
-    return 1e3 * seconds_since(loop_start) /
-           double(std::max<std::int64_t>(sim->step_count() - start_step, 1));
-  }
-  std::string progress_line(const sim::Observables& o) const;
-  void write_frame();
-  void ensure_space() {
-    on_root([&] { files->ensure_space(reserve_bytes, result.checkpoint_step >= 0); });
-  }
-  void write_checkpoint(StopReason reason);
-  void finish(const sim::Observables& o, const std::string& stop_reason, const std::string& error);
-  [[noreturn]] void blow_up(const std::string& what);
-  sim::Observables observe_checked();
-  void check_link(const sim::Observables& o);
-  StopReason test_stability(StopReason candidate);
-  bool final_files_complete(const std::string& stop_reason) const;
-  RunResult complete();
-  RunResult loop(const SignalGuard& signals);
-};
-
-// Whether every final file of a run that stopped for `stop_reason` is there: summary.json with
-// that stop_reason, final_state.csv, velocity.npy if asked for.
-bool Run::State::final_files_complete(const std::string& stop_reason) const {
-  const auto summary = try_read_text_file(dir.summary());
-  if (!summary || summary->find("\"stop_reason\": \"" + stop_reason + "\"") == std::string::npos)
-    return false;
-  std::error_code ec;
-  if (!fs::exists(dir.final_state(), ec)) return false;
-  if (c.output_fluid_velocity && !fs::exists(dir.velocity(), ec)) return false;
-  return true;
-}
 
 void Run::State::check_launch() const {
   if (distributed && c.grid_n % opt.ranks != 0)
@@ -153,73 +53,6 @@ void Run::State::check_launch() const {
     throw ConfigError("run: this ibrod was built without FFTW MPI; run it without mpirun");
   if (!opt.fftw_wisdom.empty() && !fluid::import_wisdom(opt.fftw_wisdom))
     throw ConfigError("run: cannot read FFTW wisdom from '" + opt.fftw_wisdom + "'");
-}
-
-// --resume: the checkpoint must fit the configuration (the grid and the rod exactly; any other
-// key only with --force). A run that already stopped and is resumed unchanged has nothing to do.
-void Run::State::open_checkpoint() {
-  const fs::path cp = dir.checkpoint();
-  std::error_code ec;
-  // one writer: the lock before the checkpoint is read (a run still writing it is refused)
-  if (fs::is_directory(dir.root(), ec)) on_root([&] { lock.emplace(dir.root()); });
-  if (!fs::exists(cp, ec))
-    throw ConfigError("resume: " + cp.string() +
-                      " does not exist (the run stopped before its first checkpoint, or '" +
-                      dir.root().string() + "' is not an ibrod output directory); start it again "
-                      "with --overwrite");
-  checkpoint = io::read_checkpoint(cp);
-  const io::Checkpoint& ck = *checkpoint;
-  if (ck.grid_n != c.grid_n || ck.rod.size() != c.rod_base_pairs)
-    throw ConfigError("resume: " + cp.string() + " holds a " + std::to_string(ck.grid_n) +
-                      "³ grid and " + std::to_string(ck.rod.size()) +
-                      " rod points; the configuration asks for grid.n = " +
-                      std::to_string(c.grid_n) + " and rod.base_pairs = " +
-                      std::to_string(c.rod_base_pairs) + ": incompatible, even with --force");
-  const std::string diff = config::config_differences(ck.meta.config_toml, user, cp.string());
-  config_changed = !diff.empty();
-  // a later t_end alone extends the run: the continuation is the uninterrupted longer run
-  extension = config_changed && config::only_end_time_extended(ck.meta.config_toml, user, cp.string());
-  if (extension)
-    say("ibrod: extending the run in " + dir.root().string() + " (" + diff + ")");
-  if (config_changed && !opt.force && !extension)
-    throw ConfigError("resume: the configuration differs from the one " + cp.string() +
-                      " was written with (" + diff +
-                      "); pass --force to continue with the new values (the continued run is "
-                      "then not the uninterrupted run of either configuration)");
-  if (config_changed && !extension)
-    say("ibrod: warning: resuming with a changed configuration (--force): " + diff);
-  // the time is state: a run never goes back (a shorter t_end than the checkpoint's time is an
-  // error, not a run that stops "at step 60/50")
-  const double dt = c.time_dt_ns * 1e-9, t_end = c.time_t_end_us * 1e-6;
-  const double time_ck = ck.meta.time_s >= 0 ? ck.meta.time_s : double(ck.meta.step) * dt;
-  if (t_end < time_ck - 0.5 * dt) {
-    char buf[320];
-    std::snprintf(buf, sizeof buf,
-                  "resume: time.t_end_us = %.6g is before the time of the checkpoint %s "
-                  "(%.6g us, step %lld): a run cannot go back; give a later time.t_end_us",
-                  c.time_t_end_us, cp.c_str(), time_ck / 1e-6,
-                  static_cast<long long>(ck.meta.step));
-    throw ConfigError(buf);
-  }
-  if (ck.meta.stop_reason != "none" && !config_changed && !final_files_complete(ck.meta.stop_reason)) {
-    // killed after its final checkpoint, before its final files: write them now
-    say("ibrod: the run in " + dir.root().string() + " stopped (" + ck.meta.stop_reason +
-        ") at step " + std::to_string(ck.meta.step) + " but its final files are incomplete; "
-        "writing them");
-    complete_only = true;
-    stopped_reason = sim::stop_reason_from(ck.meta.stop_reason);
-  } else if (ck.meta.stop_reason != "none" && !config_changed) {
-    say("ibrod: the run in " + dir.root().string() + " already stopped (" +
-        ck.meta.stop_reason + ") at step " + std::to_string(ck.meta.step) + "; nothing to do");
-    result.already_finished = true;
-    result.steps = ck.meta.step;
-    result.initial = ck.meta.initial;
-    result.resumed_from = result.checkpoint_step = ck.meta.step;
-    result.reason = sim::stop_reason_from(ck.meta.stop_reason);
-    throw AlreadyFinished{};
-  }
-  // the same threads as the run that wrote the checkpoint: the same round-off
-  if (c.run_threads == 0) c.run_threads = ck.meta.threads;
 }
 
 void Run::State::prepare_directory() {
@@ -258,30 +91,6 @@ void Run::State::build_simulation() {
     if (wisdom.empty()) throw RunError("output: cannot export the FFTW plans");
     io::write_file_atomic(dir.wisdom(), wisdom);
   });
-}
-
-void Run::State::restore_state() {
-  if (checkpoint) {
-    const io::Checkpoint& ck = *checkpoint;
-    meta = ck.meta;
-    ++meta.resumes;
-    sim->rod() = ck.rod;
-    const std::size_t n3 = sim->params().stepper.grid.size();
-    const double* v = ck.velocity.data();
-    sim->stepper().set_whole_velocity({v, v + n3, v + 2 * n3});
-    // checkpoints from before time was state: step × Δt of the run that wrote them
-    const double time = meta.time_s >= 0 ? meta.time_s : double(meta.step) * sim->dt();
-    sim->restore_clock(meta.step, time);
-    if (meta.implicit_next_dt_s > 0)
-      sim->restore_implicit_state({meta.implicit_next_dt_s, meta.implicit_accepted_in_a_row});
-    result.initial = meta.initial;
-    result.resumed_from = result.checkpoint_step = meta.step;
-    checkpoint.reset();  // the state lives in sim now; free the copy
-  }
-  meta.config_toml = config_text;
-  meta.threads = sim->stepper().fluid_threads();
-  meta.stop_reason = to_string(StopReason::none);
-  wall_before = meta.wall_s;
 }
 
 void Run::State::open_files() {
@@ -416,16 +225,6 @@ sim::Observables Run::State::observe_checked() {
     blow_up("the fluid velocity or an energy is not finite (E_total = " +
             format_g(o.E_total_kT) + " kT, E_K = " + format_g(o.E_kinetic_kT) + " kT)");
   return o;
-}
-
-RunResult Run::State::complete() {
-  loop_start = Clock::now();
-  start_step = sim->step_count();
-  last_row = sim->observe();
-  result.reason = stopped_reason;
-  meta.stop_reason = to_string(stopped_reason);
-  finish(last_row, to_string(stopped_reason), "");
-  return result;
 }
 
 // The kinetic-energy rule fired: test the state before calling it an equilibrium

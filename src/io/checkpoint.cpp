@@ -65,9 +65,9 @@ std::string meta_json(const CheckpointMeta& m) {
   j["max_link_drift"] = m.max_link_drift;
   j["wall_s"] = m.wall_s;
   j["resumes"] = m.resumes;
+  j["stability_tests"] = nlohmann::json::parse(m.stability_tests_json);
   j["implicit_next_dt_s"] = m.implicit_next_dt_s;
   j["implicit_accepted_in_a_row"] = m.implicit_accepted_in_a_row;
-  j["stability_tests"] = nlohmann::json::parse(m.stability_tests_json);
   j["initial"] = observables_json(m.initial);
   j["config_toml"] = m.config_toml;
   return j.dump();  // doubles with 17 significant digits: they read back exactly
@@ -86,12 +86,12 @@ CheckpointMeta meta_from(const std::string& text) {
   m.max_link_drift = j.at("max_link_drift").get<double>();
   m.wall_s = j.at("wall_s").get<double>();
   m.resumes = j.at("resumes").get<std::int64_t>();
+  m.stability_tests_json = j.contains("stability_tests") ? j.at("stability_tests").dump() : "[]";
   // absent in checkpoints from before the implicit scheme
   if (j.contains("implicit_next_dt_s")) {
     m.implicit_next_dt_s = j.at("implicit_next_dt_s").get<double>();
     m.implicit_accepted_in_a_row = j.at("implicit_accepted_in_a_row").get<int>();
   }
-  m.stability_tests_json = j.contains("stability_tests") ? j.at("stability_tests").dump() : "[]";
   m.initial = observables_from(j.at("initial"));
   m.config_toml = j.at("config_toml").get<std::string>();
   return m;

@@ -41,13 +41,13 @@ struct CheckpointMeta {
   double max_link_drift = 0;         ///< max |Lk − Lk(0)| over the output steps so far
   double wall_s = 0;                 ///< wall time of every segment of the run up to here, s
   std::int64_t resumes = 0;          ///< how many times the run was resumed
+  /// the stability tests so far (sim/stability.hpp), a JSON array of objects as summary.json
+  /// lists them
+  std::string stability_tests_json = "[]";
   /// time.scheme = "implicit": the step controller's next Δt (s; −1 if absent) and its run of
   /// accepted steps (sim::Simulation::implicit_state)
   double implicit_next_dt_s = -1;
   int implicit_accepted_in_a_row = 0;
-  /// the stability tests so far (sim/stability.hpp), a JSON array of objects as summary.json
-  /// lists them
-  std::string stability_tests_json = "[]";
 };
 
 struct Checkpoint {

@@ -153,3 +153,15 @@ TEST(Cli, VersionNamesTheVersionCommitBuildAndMpi) {
   EXPECT_TRUE(std::regex_search(r.output, std::regex(R"(^ibrod \d+\.\d+\.\d+ \(git \w+, \w+ build, MPI (yes|no)\))")))
       << r.output;
 }
+
+TEST(Cli, CheckWarnsOfAGridCoarserThanTheHardCoreAndAnUndersizedBox) {
+  const Result coarse = sh("check --set grid.n=16");  // h = 725/16 = 45 Å > D = 20 Å
+  EXPECT_EQ(coarse.status, 0) << coarse.output;
+  EXPECT_THAT(coarse.output, HasSubstr("warning: the grid spacing h = 45.3125 Å"));
+  const Result small_box = sh("check --set solvent.salt_M=0.001");  // 1/κ ≈ 96 Å: 3/κ > 725 − 649 − 20
+  EXPECT_EQ(small_box.status, 0) << small_box.output;
+  EXPECT_THAT(small_box.output, HasSubstr("periodic images"));
+  const Result fine = sh("check");  // the reference: no warning
+  EXPECT_EQ(fine.status, 0);
+  EXPECT_THAT(fine.output, ::testing::Not(HasSubstr("warning")));
+}

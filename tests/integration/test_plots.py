@@ -1,7 +1,9 @@
 #!/usr/bin/python3
 """End to end: two short runs of the real binary (ΔLk 2 at 0.1 M, ΔLk 3 at 0.05 M; 16³ grid,
-100 base pairs, 300 steps) analysed with `ibrod analyze`, one of them drawn with `ibrod render`,
-then python/ibrod_plot.py and python/ibrod_report.py on them.
+100 base pairs, 300 steps) analysed with `ibrod analyze` (one with --frames), one of them drawn
+with `ibrod render`, then python/ibrod_plot.py and python/ibrod_report.py on them. Both runs stop
+at their end time, not at equilibrium: analyze and the report must say "not finished" and give no
+writhe convergence time or τ.
 
     /usr/bin/python3 tests/integration/test_plots.py /path/to/ibrod
 
@@ -49,7 +51,8 @@ class PlotsAndReport(unittest.TestCase):
                "--set", "output.every_steps=10", "--set", "output.frame_every_steps=20",
                "--set", "run.fftw_measure=false",
                "--set", "run.threads=1")
-            sh(BINARY, "analyze", "--quiet", d)
+            r = sh(BINARY, "analyze", "--quiet", d, *(["--frames"] if dlk == 2 else []))
+            assert "warning: " in r.stdout and "not finished" in r.stdout, r.stdout
             cls.runs[(dlk, cs)] = d
         cls.a, cls.b = cls.runs[(2, 0.1)], cls.runs[(3, 0.05)]
 
@@ -68,9 +71,25 @@ class PlotsAndReport(unittest.TestCase):
             with open(os.path.join(d, "summary.json")) as f:
                 s = json.load(f)
             for key in ("writhe_convergence_time_us", "relaxation_time_us", "transients",
-                        "closest_approach_A", "kinetic_power_law_exponent", "final_energies_kT"):
+                        "closest_approach_A", "kinetic_power_law_exponent", "final_energies_kT",
+                        "shape", "contacts", "relaxation_time_local_us"):
                 self.assertIn(key, s)
             self.assertIn("stop_reason", s)  # the run's own keys survive
+            # stopped at t_end: null with a reason, never a number
+            self.assertEqual(s["stop_reason"], "end_time")
+            self.assertFalse(s["equilibrium_reached"])
+            self.assertIn("end_time", s["not_finished_reason"])
+            for key in ("writhe_convergence_time_us", "relaxation_time_us",
+                        "relaxation_time_table_us", "limiting_energies_kT"):
+                self.assertIsNone(s[key], key)
+            # the final shape of a 300-step run: still the circle; contacts from the frames
+            self.assertEqual(s["shape"]["class"], "circle")
+            self.assertEqual(s["contacts"]["source"], "trajectory.h5")
+            self.assertEqual(s["contacts"]["frames"], 16)
+        with open(os.path.join(self.a, "summary.json")) as f:
+            frames = json.load(f)["shape_frames"]  # --frames: one shape per frame
+        self.assertEqual(len(frames), 16)
+        self.assertEqual(frames[0]["class"], "circle")
         # only run a is rendered, so the report draws b with matplotlib 3-D
         r = sh(BINARY, "render", self.a, "--views", "top,oblique", "--size", "240x180")
         files = [l for l in r.stdout.splitlines() if l.endswith(".png")]
@@ -97,23 +116,39 @@ class PlotsAndReport(unittest.TestCase):
     def test_3_report(self):
         rep = os.path.join(self.tmp, "report")
         sh(PYTHON, REPORT, self.a, self.b, "-o", rep)
-        for name in ("shapes.png", "vs_excess_link.png", "timeseries_Cs0.05.png",
-                     "timeseries_Cs0.1.png"):
+        for name in ("shapes.png", "vs_excess_link.png", "timeseries.png"):
             self.png(os.path.join(rep, name))
         with open(os.path.join(rep, "report.md")) as f:
             md = f.read()
         self.assertIn("| ΔLk | Cs = 0.05 M | Cs = 0.1 M |", md)
-        self.assertIn("## Writhe convergence time", md)
-        self.assertIn("## Relaxation time", md)
+        for section in ("## Writhe convergence time", "## Relaxation time", "## Final shapes",
+                        "## Transient states"):
+            self.assertIn(section, md)
         self.assertNotIn("not analysed", md)
+        # the writhe convergence and τ tables: "not finished" in every filled cell
+        for section in ("## Writhe convergence time", "## Relaxation time"):
+            part = md.split(section)[1].split("## ")[0]
+            rows = [l for l in part.splitlines() if l.startswith("| 2 ") or l.startswith("| 3 ")]
+            self.assertEqual(len(rows), 2, part)
+            for l in rows:
+                self.assertIn("not finished", l)
+                self.assertNotRegex(l.split("|", 2)[2], r"\d")
+        self.assertIn("circle, 1 loops", md.split("## Final shapes")[1])
         with open(os.path.join(rep, "runs.csv")) as f:
             rows = list(csv.DictReader(f))
         self.assertEqual(sorted(int(r["excess_link"]) for r in rows), [2, 3])
-        self.assertTrue(all(r["writhe_convergence_time_us"] != "" for r in rows))
+        self.assertTrue(all(r["writhe_convergence_time_us"] == "" for r in rows))  # null
+        self.assertTrue(all(r["shape"] == "circle" for r in rows))
         # --ibrod renders the run that has no picture yet
         self.assertFalse(os.path.isdir(os.path.join(self.b, "render")))
         sh(PYTHON, REPORT, self.a, self.b, "-o", rep, "--ibrod", BINARY)
         self.assertTrue(any(f.startswith("rod_oblique_t") for f in os.listdir(os.path.join(self.b, "render"))))
+        # `ibrod report` is the same script, with the binary as --ibrod
+        rep2 = os.path.join(self.tmp, "report2")
+        sh(BINARY, "report", self.a, self.b, "-o", rep2)
+        with open(os.path.join(rep2, "report.md")) as f:
+            self.assertIn("## Relaxation time", f.read())
+        self.assertNotEqual(sh(BINARY, "report", check=False).returncode, 0)  # no run: usage
 
 
 if __name__ == "__main__":

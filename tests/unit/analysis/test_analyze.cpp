@@ -87,7 +87,7 @@ TEST(Analyze, KnownAnswersOfASyntheticSeries) {
   const Analysis a = analyze_timeseries(read_csv_table(d.path / "timeseries.csv"));
   EXPECT_EQ(a.rows, 401u);
   // |Wr − Wr(2 µs)| = 0.8 (e^{−t/0.1} − e^{−20}) = 0.01 at t = 0.1 ln 80
-  EXPECT_NEAR(a.writhe_convergence_time_us, 0.1 * std::log(80.0), 1e-4);
+  EXPECT_NEAR(*a.writhe_convergence_time_us, 0.1 * std::log(80.0), 1e-4);
   ASSERT_TRUE(a.relaxation_time_us);
   EXPECT_NEAR(*a.relaxation_time_us, 0.25, 1e-6);
   ASSERT_TRUE(a.relaxation_fit);
@@ -166,9 +166,85 @@ TEST(Analyze, CircularRunGetsAPowerLaw) {
   EXPECT_TRUE(a.stays_circular);
   ASSERT_TRUE(a.kinetic_power_law_exponent);
   EXPECT_NEAR(*a.kinetic_power_law_exponent, -1.5, 1e-6);
-  EXPECT_EQ(a.writhe_convergence_time_us, 0.0);  // Wr constant: inside the band from the start
+  // no summary.json: whether it reached equilibrium is unknown, so no convergence time
+  EXPECT_FALSE(a.writhe_convergence_time_us);
+  EXPECT_NE(a.not_finished_reason.find("no stop_reason"), std::string::npos);
   const auto j = nlohmann::json::parse(read_file(d.path / "summary.json"));  // created
   EXPECT_NEAR(j["kinetic_power_law_exponent"].get<double>(), -1.5, 1e-6);
+  // Wr constant: inside the band from the start
+  EXPECT_EQ(analyze_timeseries(read_csv_table(d.path / "timeseries.csv")).writhe_convergence_time_us, 0.0);
+}
+
+TEST(Analyze, UnfinishedRunGivesNullWithAReasonNeverANumber) {
+  TempDir d("unfinished");
+  write(d.path / "timeseries.csv", synthetic_timeseries(201, 0.01));
+  for (const char* reason : {"end_time", "interrupted"}) {
+    write(d.path / "summary.json", std::string(R"({"stop_reason": ")") + reason + "\"}");
+    const Analysis a = analyze_run(d.path);
+    EXPECT_FALSE(a.equilibrium);
+    EXPECT_FALSE(a.writhe_convergence_time_us);
+    EXPECT_FALSE(a.relaxation_time_us);
+    EXPECT_FALSE(a.relaxation_time_table_us);
+    ASSERT_EQ(a.warnings.size(), 1u);
+    EXPECT_NE(a.warnings[0].find("not finished"), std::string::npos);
+    const auto j = nlohmann::json::parse(read_file(d.path / "summary.json"));
+    EXPECT_EQ(j["equilibrium_reached"], false);
+    EXPECT_NE(j["not_finished_reason"].get<std::string>().find(reason), std::string::npos);
+    for (const char* key : {"writhe_convergence_time_us", "relaxation_time_us", "relaxation_fit",
+                            "relaxation_time_contacts_us", "relaxation_time_table_us",
+                            "limiting_energies_kT"})
+      EXPECT_TRUE(j[key].is_null()) << reason << ": " << key << " = " << j[key];
+    EXPECT_FALSE(j["final_energies_kT"].is_null());  // the last row's values, as they are
+  }
+  // the same series from a run that reached equilibrium: numbers
+  write(d.path / "summary.json", R"({"stop_reason": "equilibrium"})");
+  const Analysis a = analyze_run(d.path);
+  EXPECT_TRUE(a.equilibrium);
+  EXPECT_TRUE(a.warnings.empty());
+  const auto j = nlohmann::json::parse(read_file(d.path / "summary.json"));
+  EXPECT_EQ(j["equilibrium_reached"], true);
+  EXPECT_TRUE(j["not_finished_reason"].is_null());
+  EXPECT_NEAR(j["relaxation_time_us"].get<double>(), 0.25, 1e-6);
+  EXPECT_TRUE(j["limiting_energies_kT"].is_object());
+  // no trajectory: the table's τ is the final-window fit, and the summary says so
+  EXPECT_EQ(j["relaxation_time_method"], "final_window");
+  EXPECT_NEAR(j["relaxation_time_table_us"].get<double>(), 0.25, 1e-6);
+  EXPECT_NE(j["relaxation_contacts_note"].get<std::string>().find("no trajectory.h5"), std::string::npos);
+  EXPECT_TRUE(j["contacts"]["source"].is_null());
+}
+
+TEST(Analyze, RelaxationTimeAfterTheLastContactChange) {
+  // E_K decays with τ = 0.1 µs until t = 1 µs (contacts still forming), then with τ = 0.5 µs; the
+  // last change of the contact count is at t = 1 µs
+  TempDir d("contacts");
+  std::ostringstream os;
+  os << kHeader;
+  os.precision(15);
+  for (int i = 0; i <= 300; ++i) {
+    const double t = 0.01 * i;
+    const double ek = t < 1 ? std::exp(-2 * t / 0.1) : std::exp(-2 / 0.1) * std::exp(-2 * (t - 1) / 0.5);
+    os << i << "," << t << ",1,1,1,1,0,0," << ek << "," << 4 + ek << ",0.5,1,1,50,3.4\n";
+  }
+  write(d.path / "timeseries.csv", os.str());
+  const CsvTable table = read_csv_table(d.path / "timeseries.csv");
+  Analysis a = analyze_timeseries(table);
+  ShapeAnalysis sh;
+  sh.contact_distance_A = 50;
+  sh.contacts.time_us = {0, 0.5, 0.9, 1.0, 2.0, 3.0};
+  sh.contacts.clusters = {0, 1, 1, 2, 2, 2};
+  add_contact_relaxation(a, table, sh);
+  ASSERT_TRUE(a.contacts_settled_time_us);
+  EXPECT_EQ(*a.contacts_settled_time_us, 1.0);
+  ASSERT_TRUE(a.relaxation_time_contacts_us);
+  EXPECT_NEAR(*a.relaxation_time_contacts_us, 0.5, 1e-9);
+  EXPECT_EQ(a.relaxation_time_method, "after_last_contact");
+  EXPECT_EQ(a.relaxation_time_table_us, a.relaxation_time_contacts_us);
+  EXPECT_NEAR(a.relaxation_contacts_fit->t_start_us, 1.0, 1e-12);
+  // τ(t) over 1 µs windows: 0.1 µs in the first, 0.5 µs in the others
+  ASSERT_EQ(a.local_relaxation.size(), 3u);
+  EXPECT_NEAR(a.local_relaxation[0].tau, 0.1, 1e-9);
+  EXPECT_NEAR(a.local_relaxation[1].tau, 0.5, 1e-9);
+  EXPECT_NEAR(a.local_relaxation[2].tau, 0.5, 1e-9);
 }
 
 TEST(RunInfo, ReadsTheKeysLeniently) {

@@ -178,5 +178,52 @@ TEST(Series, SizeMismatchThrows) {
   EXPECT_THROW(transients(t, t, y), std::invalid_argument);
 }
 
+TEST(RelaxationAfter, FitsEveryRowFromTheStartOnly) {
+  // τ = 0.2 before t = 2, τ = 1 after; the fit from t = 2 sees only the slow mode
+  std::vector<double> t, e;
+  for (int i = 0; i <= 400; ++i) {
+    const double x = 0.01 * i;
+    t.push_back(x);
+    e.push_back(x < 2 ? std::exp(-2 * x / 0.2) : std::exp(-20.0) * std::exp(-2 * (x - 2) / 1.0));
+  }
+  const auto f = relaxation_time_from(t, e, 2.0);
+  ASSERT_TRUE(f);
+  EXPECT_NEAR(f->tau, 1.0, 1e-9);
+  EXPECT_EQ(f->line.first, 200u);
+  EXPECT_NEAR(f->line.r2, 1.0, 1e-12);
+  const auto g = relaxation_time_from(t, e, 0.0);  // both modes: neither τ
+  ASSERT_TRUE(g);
+  EXPECT_LT(g->line.r2, 0.99);
+  EXPECT_FALSE(relaxation_time_from(t, e, 3.97));  // 3 rows < 5
+  std::vector<double> grow(e.rbegin(), e.rend());
+  EXPECT_FALSE(relaxation_time_from(t, grow, 2.0));  // E_K grows: no τ
+}
+
+TEST(RelaxationAfter, LocalTauPerWindowAndSettledTime) {
+  std::vector<double> t, e;
+  for (int i = 0; i < 300; ++i) {
+    const double x = 0.01 * i;  // 0 … 2.99
+    t.push_back(x);
+    e.push_back(std::exp(-2 * x * x));  // d ln E/dt = −4t: τ(t) = 1/(2t)
+  }
+  const auto w = local_relaxation_times(t, e, 1.0);
+  ASSERT_EQ(w.size(), 3u);
+  EXPECT_NEAR(w[1].tau, 1 / (2 * 1.495), 1e-3);  // the window's mean slope
+  EXPECT_NEAR(w[2].tau, 1 / (2 * 2.495), 1e-3);
+  EXPECT_EQ(w[1].points, 100u);
+  EXPECT_THROW(local_relaxation_times(t, e, 0.0), std::invalid_argument);
+  // times 0.01 i against 0.1-wide windows: edges that rounding puts on either side (this once
+  // looped for ever); every sample in one window, 10 windows of 10 samples in the first µs
+  const auto narrow = local_relaxation_times(t, e, 0.1);
+  std::size_t points = 0;
+  for (const auto& x : narrow) points += x.points;
+  EXPECT_EQ(points, t.size());
+  EXPECT_GE(narrow.size(), 29u);
+  const std::vector<double> tc{0, 1, 2, 3, 4};
+  EXPECT_EQ(settled_time(tc, std::vector<int>{0, 1, 1, 2, 2}), 3.0);
+  EXPECT_EQ(settled_time(tc, std::vector<int>{1, 1, 1, 1, 1}), 0.0);
+  EXPECT_EQ(settled_time(tc, std::vector<int>{1, 2, 1, 1, 3}), 4.0);
+}
+
 }  // namespace
 }  // namespace ibrod::diagnostics
