@@ -1,5 +1,3 @@
-#include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -275,13 +273,13 @@ const std::vector<Key>& schema() {
               std::numeric_limits<std::int64_t>::max(),
               "seed of the stability test's perturbation"),
       scheme_key(),
-      real("time.max_displacement_A", &Config::time_max_displacement_A, 0, false, inf,
+      real("time.max_displacement_A", &Config::time_max_displacement_A, 0, false, 1e4,
            "implicit: largest move of a rod point in one step, Å; a longer step is retried "
            "shorter (0: 0.2 min(Debye length, steric.diameter_A))"),
-      real("time.energy_tolerance_kT", &Config::time_energy_tolerance_kT, 0, false, inf,
+      real("time.energy_tolerance_kT", &Config::time_energy_tolerance_kT, 0, false, 1e6,
            "implicit: largest rise of the potential energy in one step, kT; a step that raises "
            "it more is retried shorter"),
-      real("time.dt_min_ns", &Config::time_dt_min_ns, 0, false, inf,
+      real("time.dt_min_ns", &Config::time_dt_min_ns, 0, false, kMaxDtNs,
            "implicit: smallest step, ns, always accepted (0: time.dt_ns/1000)"),
       real("time.implicit_mobility_scale", &Config::time_implicit_mobility_scale, 0, true, 1e6,
            "implicit: local mobility M_loc = this × the kernel's self mobility"),
@@ -442,18 +440,6 @@ void apply_override(Config& c, const std::string& assignment) {
   try {
     t = toml::parse("v = " + value, "--set " + key);
   } catch (const toml::parse_error& e) {
-    // a bare word is a string, as people type it (--set time.scheme=implicit); a key that is not
-    // a string then says what it expects
-    const bool word =
-        !value.empty() && std::isalpha(static_cast<unsigned char>(value[0])) &&
-        std::all_of(value.begin(), value.end(), [](char ch) {
-          return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-';
-        });
-    if (word) {
-      t = toml::parse("v = \"" + value + "\"", "--set " + key);
-      set_key(c, key, *t.get("v"));
-      return;
-    }
     throw ConfigError("config: --set " + echo(key) + "=" + echo(value) +
                       ": the value is not a TOML number, boolean, string or array (" +
                       echo(std::string(e.description()), 200) + ")");
