@@ -1,3 +1,5 @@
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -27,7 +29,6 @@ Config::Config()
     : electrostatics_cutoff_debye(interactions::kDefaultCutoffDebye),
       steric_stiffness_kT_A2(interactions::kDefaultStericStiffness / units::kT(300.0)) {}
 
-
 namespace {
 
 std::string show(const toml::node& n) {
@@ -35,7 +36,6 @@ std::string show(const toml::node& n) {
   n.visit([&](auto&& v) { os << v; });
   return os.str();
 }
-
 
 // One config key: how to read it from TOML into Config, and how to write it back.
 struct Key {
@@ -93,7 +93,9 @@ Key integer(std::string name, Int Config::*m, int64_t lo, int64_t hi, std::strin
     if (v < lo || v > hi) bad(name, show(n), allowed + " (" + help + ")");
     c.*m = Int(v);
   };
-  k.put = [=](const Config& c, toml::table& t) { t.insert_or_assign(leaf_of(name), int64_t(c.*m)); };
+  k.put = [=](const Config& c, toml::table& t) {
+    t.insert_or_assign(leaf_of(name), int64_t(c.*m));
+  };
   k.value = [=](const Config& c) { return std::to_string(c.*m); };
   return k;
 }
@@ -113,7 +115,8 @@ Key boolean(std::string name, bool Config::*m, std::string help) {
 }
 
 Key real_array(std::string name, std::vector<double> Config::*m, double max_abs, std::string help) {
-  const std::string allowed = "an array of numbers with |value| <= " + fmt(max_abs) + " (" + help + ")";
+  const std::string allowed =
+      "an array of numbers with |value| <= " + fmt(max_abs) + " (" + help + ")";
   Key k;
   k.name = name;
   k.help = help;
@@ -173,8 +176,9 @@ Key frame_key() {
 Key scheme_key() {
   Key k;
   k.name = "time.scheme";
-  k.help = "time scheme: \"explicit\" (MODEL §4, the reference) or \"implicit\" (Stokes limit, "
-           "implicit stiffness, adaptive Δt ≤ time.dt_ns; docs/large_dt.md)";
+  k.help =
+      "time scheme: \"explicit\" (MODEL §4, the reference) or \"implicit\" (Stokes limit, "
+      "implicit stiffness, adaptive Δt ≤ time.dt_ns; docs/large_dt.md)";
   k.set = [](Config& c, const toml::node& n) {
     const auto v = n.value_exact<std::string>();
     if (!v || (*v != "explicit" && *v != "implicit"))
@@ -228,8 +232,8 @@ Key random_perturbation_key() {
   };
   k.put = [](const Config& c, toml::table& t) {
     const RandomPerturbation& r = c.rod_perturbation_random;
-    toml::table v{{"modes", int64_t(r.modes)}, {"amplitude", r.amplitude},
-                  {"seed", int64_t(r.seed)}};
+    toml::table v{
+        {"modes", int64_t(r.modes)}, {"amplitude", r.amplitude}, {"seed", int64_t(r.seed)}};
     v.is_inline(true);
     t.insert_or_assign("perturbation_random", v);
   };
@@ -286,13 +290,12 @@ const std::vector<Key>& schema() {
       integer("time.implicit_jacobian_every", &Config::time_implicit_jacobian_every, 1, 1000000,
               "implicit: steps between refreshes of the stiffness and its factorisation (> 1: "
               "faster; a run resumed after a signal is then not bitwise the same)"),
-      integer("time.implicit_krylov_iterations", &Config::time_implicit_krylov_iterations, 0,
-              1000, "implicit: GMRES iterations toward linearly implicit Euler (0: none, IMEX)"),
+      integer("time.implicit_krylov_iterations", &Config::time_implicit_krylov_iterations, 0, 1000,
+              "implicit: GMRES iterations toward linearly implicit Euler (0: none, IMEX)"),
       real("time.implicit_krylov_tol", &Config::time_implicit_krylov_tol, 0, true, 1,
            "implicit: relative residual at which GMRES stops (not reached: the step is retried "
            "shorter)"),
-      integer("rod.base_pairs", &Config::rod_base_pairs, 8, 1000000,
-              "rod points = base pairs n"),
+      integer("rod.base_pairs", &Config::rod_base_pairs, 8, 1000000, "rod points = base pairs n"),
       integer("rod.excess_link", &Config::rod_excess_link, -1000, 1000,
               "excess link ΔLk of the initial circle, an integer"),
       real_array("rod.perturbation", &Config::rod_perturbation, 100.0,
@@ -402,7 +405,6 @@ std::int64_t frame_every(const Config& c) {
   return c.output_frame_every_steps < 0 ? c.output_every_steps : c.output_frame_every_steps;
 }
 
-
 void apply_toml(Config& c, const std::string& text, const std::string& source) {
   const toml::table tbl = parse_toml(text, source, "config");
   for (auto&& [sec, node] : tbl) {
@@ -415,14 +417,12 @@ void apply_toml(Config& c, const std::string& text, const std::string& source) {
   }
 }
 
-
 Config load_config(const std::string& path) {
   Config c;
   if (path.empty()) return c;
   apply_toml(c, read_text_file(path, "config"), path);
   return c;
 }
-
 
 void apply_override(Config& c, const std::string& assignment) {
   const auto eq = assignment.find('=');
@@ -440,13 +440,24 @@ void apply_override(Config& c, const std::string& assignment) {
   try {
     t = toml::parse("v = " + value, "--set " + key);
   } catch (const toml::parse_error& e) {
+    // a bare word is a string, as people type it (--set time.scheme=implicit); a key that is not
+    // a string then says what it expects
+    const bool word =
+        !value.empty() && std::isalpha(static_cast<unsigned char>(value[0])) &&
+        std::all_of(value.begin(), value.end(), [](char ch) {
+          return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-';
+        });
+    if (word) {
+      t = toml::parse("v = \"" + value + "\"", "--set " + key);
+      set_key(c, key, *t.get("v"));
+      return;
+    }
     throw ConfigError("config: --set " + echo(key) + "=" + echo(value) +
                       ": the value is not a TOML number, boolean, string or array (" +
                       echo(std::string(e.description()), 200) + ")");
   }
   set_key(c, key, *t.get("v"));
 }
-
 
 std::string to_toml(const Config& c) {
   toml::table root;
@@ -459,7 +470,6 @@ std::string to_toml(const Config& c) {
   os << "# ibrod resolved configuration (every key, defaults included)\n" << root << "\n";
   return os.str();
 }
-
 
 std::string describe(const Config& c) {
   std::ostringstream os;

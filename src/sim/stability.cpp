@@ -55,6 +55,7 @@ ProbeOutcome probe_stability(Simulation& sim, const StabilityProbe& p, std::uint
   for (int c = 0; c < 3; ++c) std::copy_n(u[std::size_t(c)], n3, saved_u.begin() + c * n3);
   const std::int64_t saved_step = sim.step_count();
   const double saved_time = sim.time();
+  const auto saved_implicit = sim.implicit_state();  // time.scheme = "implicit": its controller
 
   // 2. perturb, 3. integrate
   perturb_twist(sim.rod(), p, index);
@@ -76,6 +77,7 @@ ProbeOutcome probe_stability(Simulation& sim, const StabilityProbe& p, std::uint
     const double* v = saved_u.data();
     sim.stepper().set_whole_velocity({v, v + n3, v + 2 * n3});
     sim.restore_clock(saved_step, saved_time);
+    sim.restore_implicit_state(saved_implicit);
   }
   return o;
 }
