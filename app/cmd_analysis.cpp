@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
+#include "analysis/frames.hpp"
 #include "core/error.hpp"
 #include "exit_status.hpp"
-#include "analysis/frames.hpp"
 #include "render/render.hpp"
 
 namespace {
@@ -60,9 +60,10 @@ std::filesystem::path report_script() {
 void add_analysis_commands(CLI::App& app) {
   // ---- report: the Python report, called the same way (docs/analysis.md)
   auto* report = app.add_subcommand(
-      "report", "write the report of a sweep (tables, figures, contact sheet) with "
-                "python/ibrod_report.py: ibrod report RUN_DIR... -o REPORT_DIR [--frames]; the "
-                "binary is passed as --ibrod, so runs are analysed first");
+      "report",
+      "write the report of a sweep (tables, figures, contact sheet) with "
+      "python/ibrod_report.py: ibrod report RUN_DIR... -o REPORT_DIR [--frames]; the "
+      "binary is passed as --ibrod, so runs are analysed first");
   report->prefix_command();  // every argument goes to the script
   report->callback([report] {
     finish([&] {
@@ -90,27 +91,33 @@ void add_analysis_commands(CLI::App& app) {
   };
   auto a = std::make_shared<AnalyzeArgs>();
   auto* analyze = app.add_subcommand(
-      "analyze", "add the time-series analysis (writhe convergence, relaxation time τ, transient "
-                 "states, power law) and the shape of the final state (with --frames of every "
-                 "frame) to DIR/summary.json; see docs/analysis.md");
+      "analyze",
+      "add the time-series analysis (writhe convergence, relaxation time τ, transient "
+      "states, power law) and the shape of the final state (with --frames of every "
+      "frame) to DIR/summary.json; see docs/analysis.md");
   analyze->add_option("dir", a->dir, "run directory (written by ibrod run)")->required();
-  analyze->add_option("--delta", a->opt.writhe_delta,
-                      "band |Wr − Wr(∞)| of the writhe convergence time")
+  analyze
+      ->add_option("--delta", a->opt.writhe_delta,
+                   "band |Wr − Wr(∞)| of the writhe convergence time")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  analyze->add_option("--fit-tolerance", a->opt.fit.tolerance,
-                      "largest |residual| of ln E_K in a fit window (0.02: 2 %)")
+  analyze
+      ->add_option("--fit-tolerance", a->opt.fit.tolerance,
+                   "largest |residual| of ln E_K in a fit window (0.02: 2 %)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  analyze->add_flag("--frames", a->opt.every_frame,
-                    "also the shape of every frame of DIR/trajectory.h5 (summary.json shape_frames)");
-  analyze->add_option("--contact-distance", a->opt.contact_distance_A,
-                      "contact distance d_c in Å (default: D + 3 Debye lengths of config.toml)")
+  analyze->add_flag(
+      "--frames", a->opt.every_frame,
+      "also the shape of every frame of DIR/trajectory.h5 (summary.json shape_frames)");
+  analyze
+      ->add_option("--contact-distance", a->opt.contact_distance_A,
+                   "contact distance d_c in Å (default: D + 3 Debye lengths of config.toml)")
       ->check(CLI::PositiveNumber);
   analyze->add_option("--tau-window", a->opt.tau_window_us, "window of τ(t) in µs")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  analyze->add_flag("-q,--quiet", a->quiet, "print nothing on success (warnings still go to stderr)");
+  analyze->add_flag("-q,--quiet", a->quiet,
+                    "print nothing on success (warnings still go to stderr)");
   analyze->callback([a] {
     finish([&] {
       const auto result = ibrod::analysis::analyze_run(a->dir, a->opt);
@@ -129,12 +136,14 @@ void add_analysis_commands(CLI::App& app) {
   auto* render = app.add_subcommand(
       "render", "draw the rod as a shaded tube with a stripe along D1 into DIR/render/*.png");
   render->add_option("dir", r->dir, "run directory (written by ibrod run)")->required();
-  render->add_option("--time", r->opt.times,
-                     "time in µs (nearest frame of DIR/trajectory.h5) or 'final'; repeatable or "
-                     "comma-separated (default: final)")
+  render
+      ->add_option("--time", r->opt.times,
+                   "time in µs (nearest frame of DIR/trajectory.h5) or 'final'; repeatable or "
+                   "comma-separated (default: final)")
       ->delimiter(',');
-  render->add_option("--views", r->opt.views,
-                     "comma-separated, of: " + join(ibrod::render::standard_view_names()))
+  render
+      ->add_option("--views", r->opt.views,
+                   "comma-separated, of: " + join(ibrod::render::standard_view_names()))
       ->delimiter(',')
       ->default_str(join(r->opt.views));
   render->add_option("--size", r->size, "image size WxH in pixels")->capture_default_str();

@@ -36,15 +36,16 @@ struct RunArgs : ConfigArgs {
 
 struct BenchArgs : ConfigArgs {
   int steps = 200, threads = 0;
-  bool schemes = false;          // issue 14: explicit against implicit, µs per wall hour
+  bool schemes = false;  // issue 14: explicit against implicit, µs per wall hour
   double implicit_dt_ns = 2, implicit_ns = 200;
 };
 
 cfg::Config resolve(const ConfigArgs& a) {
   // `ibrod run ""` is not `ibrod run`: an empty path is refused, not read as "defaults"
   if (a.config_given && a.config_path.empty())
-    throw ibrod::ConfigError("config: cannot read file '': the path is empty (omit CONFIG for "
-                             "the built-in reference run)");
+    throw ibrod::ConfigError(
+        "config: cannot read file '': the path is empty (omit CONFIG for "
+        "the built-in reference run)");
   cfg::Config c = cfg::load_config(a.config_path);
   for (const auto& s : a.sets) cfg::apply_override(c, s);
   cfg::validate(c);
@@ -106,8 +107,8 @@ int run_main(RunArgs a) {
 int check_main(const ConfigArgs& a) {
   try {
     const cfg::Config c = resolve(a);
-    std::printf("# resolved configuration\n%s\n# derived quantities\n%s",
-                cfg::describe(c).c_str(), cfg::derived_report(c).c_str());
+    std::printf("# resolved configuration\n%s\n# derived quantities\n%s", cfg::describe(c).c_str(),
+                cfg::derived_report(c).c_str());
     for (const std::string& w : cfg::check_warnings(c)) std::printf("# warning: %s\n", w.c_str());
     // a config may be meant for a larger machine: `check` warns where `run` would refuse
     try {
@@ -163,8 +164,7 @@ void add_run_commands(CLI::App& app) {
   run->callback([ra] { throw CLI::RuntimeError(run_main(*ra)); });
 
   auto ca = std::make_shared<ConfigArgs>();
-  auto* check =
-      app.add_subcommand("check", "print the resolved parameters and derived quantities");
+  auto* check = app.add_subcommand("check", "print the resolved parameters and derived quantities");
   add_config_args(check, *ca);
   check->callback([ca] { throw CLI::RuntimeError(check_main(*ca)); });
 

@@ -8,9 +8,9 @@
 #include <string>
 
 #include "core/error.hpp"
-#include "exit_status.hpp"
 #include "driver/mpi_env.hpp"
 #include "driver/sweep_runner.hpp"
+#include "exit_status.hpp"
 
 namespace {
 
@@ -34,20 +34,21 @@ int sweep_main(const SweepArgs& a) {
   try {
     const ibrod::driver::Sweep sw = ibrod::driver::load_sweep(a.file);
     ibrod::driver::SweepOptions opt;
-    opt.output_root = !a.output.empty()          ? fs::path(a.output)
+    opt.output_root = !a.output.empty()         ? fs::path(a.output)
                       : !sw.output_root.empty() ? fs::path(sw.output_root)
                                                 : fs::path(fs::path(a.file).stem());
     if (a.list) {
       if (root)
         for (const auto& pt : sw.points)
-          std::printf("%4zu  %-40s %s\n", pt.index, pt.name.c_str(),
-                      ibrod::driver::to_string(ibrod::driver::point_state(opt.output_root / pt.name)));
+          std::printf(
+              "%4zu  %-40s %s\n", pt.index, pt.name.c_str(),
+              ibrod::driver::to_string(ibrod::driver::point_state(opt.output_root / pt.name)));
       return 0;
     }
     if (a.point >= 0) {
       if (std::size_t(a.point) >= sw.points.size())
-        throw ibrod::ConfigError("sweep: --point " + std::to_string(a.point) + " is not a point of " +
-                                 a.file + ": its points are 0 to " +
+        throw ibrod::ConfigError("sweep: --point " + std::to_string(a.point) +
+                                 " is not a point of " + a.file + ": its points are 0 to " +
                                  std::to_string(sw.points.size() - 1) + " (--list shows them)");
       opt.only_point = a.point;
     }
@@ -65,12 +66,15 @@ int sweep_main(const SweepArgs& a) {
     const long long skipped = ibrod::driver::mpi::sum(r.skipped);
     const long long elsewhere = ibrod::driver::mpi::sum(r.running);
     if (world.size > 1 && root)
-      std::printf("sweep: all ranks: %lld points, %lld finished now, %lld already finished, %lld "
-                  "failed\n",
-                  points, completed, skipped, failed);
+      std::printf(
+          "sweep: all ranks: %lld points, %lld finished now, %lld already finished, %lld "
+          "failed\n",
+          points, completed, skipped, failed);
     if (elsewhere > 0 && root)
-      std::fprintf(stderr, "ibrod: sweep: %lld points are still being written by another process; "
-                           "run the sweep again when they are done\n", elsewhere);
+      std::fprintf(stderr,
+                   "ibrod: sweep: %lld points are still being written by another process; "
+                   "run the sweep again when they are done\n",
+                   elsewhere);
     status = sig ? 128 + int(sig) : (failed > 0 || elsewhere > 0) ? 4 : 0;
   } catch (const std::exception& e) {
     // a bad sweep file is the same on every rank: only rank 0 says so
@@ -94,10 +98,11 @@ void add_sweep_command(CLI::App& app) {
                     "root of the point directories (default: `output_dir` of the sweep file, else "
                     "the sweep file's name without .toml)");
   sweep->add_flag("--list", a->list, "print every point's index, name and state, run nothing");
-  sweep->add_option("--point", a->point,
-                    "run point K alone (0-based, as --list numbers them), with the same naming, "
-                    "skipping and resuming rules: one task of a scheduler's job array "
-                    "(e.g. --point $SLURM_ARRAY_TASK_ID)")
+  sweep
+      ->add_option("--point", a->point,
+                   "run point K alone (0-based, as --list numbers them), with the same naming, "
+                   "skipping and resuming rules: one task of a scheduler's job array "
+                   "(e.g. --point $SLURM_ARRAY_TASK_ID)")
       ->check(CLI::NonNegativeNumber);
   sweep->callback([a] { throw CLI::RuntimeError(sweep_main(*a)); });
 }

@@ -4,8 +4,8 @@
 // shared round-robin among the R ranks (each running K at a time). Like add_analysis_commands,
 // the subcommand runs from its CLI11 callback and ends parsing by throwing
 // CLI::RuntimeError(status): 0 every point finished, 2 a bad sweep file, 4 some points failed
-// (named on stderr) or are still being written by another process, 128 + N stopped by signal N (run the same command again to continue).
-// main needs only: add_sweep_command(app) before app.parse.
+// (named on stderr) or are still being written by another process, 128 + N stopped by signal N (run
+// the same command again to continue). main needs only: add_sweep_command(app) before app.parse.
 #include <CLI/CLI.hpp>
 
 void add_sweep_command(CLI::App& app);

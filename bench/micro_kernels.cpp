@@ -10,12 +10,12 @@
 #include <random>
 #include <vector>
 
+#include "config/config.hpp"
 #include "diagnostics/topology.hpp"
 #include "fluid/advection.hpp"
 #include "fluid/navier_stokes.hpp"
 #include "ib/plane_coupler.hpp"
 #include "interactions/interactions.hpp"
-#include "config/config.hpp"
 #include "rod/rod.hpp"
 #include "sim/simulation.hpp"
 
@@ -35,7 +35,8 @@ config::Config reference(int grid_n = 64, int points = 600, double salt = 0.1) {
 // the circle gets a deterministic out-of-plane wave (what matters is the point distribution).
 rod::RodState ring(const sim::SimParams& p) {
   rod::RodState s = rod::twisted_circle(p.stepper.rod, p.circle);
-  for (int k = 0; k < s.size(); ++k) s.X[k][2] += 20.0 * std::sin(3.0 * 2.0 * std::numbers::pi * k / s.size());
+  for (int k = 0; k < s.size(); ++k)
+    s.X[k][2] += 20.0 * std::sin(3.0 * 2.0 * std::numbers::pi * k / s.size());
   return s;
 }
 
@@ -157,8 +158,8 @@ BENCHMARK(BM_Steric)->Unit(benchmark::kMicrosecond)->UseRealTime();
 struct FluidFixture {
   fluid::FluidSolver fl;
   explicit FluidFixture(int n)
-      : fl(config::to_params(reference(n)).stepper.grid, config::to_params(reference(n)).stepper.fluid,
-           omp_get_max_threads(), true) {
+      : fl(config::to_params(reference(n)).stepper.grid,
+           config::to_params(reference(n)).stepper.fluid, omp_get_max_threads(), true) {
     for (int c = 0; c < 3; ++c) fill_random(fl.velocity(c), fl.grid().size(), 1e6, 5 + c);
   }
 };
@@ -188,7 +189,12 @@ void BM_FftRoundTrip(benchmark::State& st) {
   for (auto _ : st) fx.fl.run_ffts_only();
   st.SetItemsProcessed(st.iterations() * std::int64_t(fx.fl.grid().size()));
 }
-BENCHMARK(BM_FftRoundTrip)->Arg(32)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_FftRoundTrip)
+    ->Arg(32)
+    ->Arg(64)
+    ->Arg(128)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // the whole fluid step as the stepper does it (no forces)
 void BM_FluidStep(benchmark::State& st) {

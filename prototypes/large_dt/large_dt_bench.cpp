@@ -12,23 +12,27 @@
 #include <map>
 #include <string>
 
-#include "integrate/implicit.hpp"
 #include "config/config.hpp"
+#include "integrate/implicit.hpp"
 
 using namespace ibrod;
 
 int main(int argc, char** argv) {
-  std::map<std::string, std::string> kv{
-      {"dt_max_ns", "2"}, {"implicit_ns", "200"}, {"explicit_steps", "300"}, {"beta", "8"},
-      {"jac_every", "0"}};
+  std::map<std::string, std::string> kv{{"dt_max_ns", "2"},
+                                        {"implicit_ns", "200"},
+                                        {"explicit_steps", "300"},
+                                        {"beta", "8"},
+                                        {"jac_every", "0"}};
   config::Config cfg;
   config::apply_override(cfg, "run.threads=2");
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const auto eq = a.find('=');
     if (eq == std::string::npos) return std::fprintf(stderr, "bad argument %s\n", a.c_str()), 2;
-    if (a.substr(0, eq).find('.') != std::string::npos) config::apply_override(cfg, a);
-    else kv[a.substr(0, eq)] = a.substr(eq + 1);
+    if (a.substr(0, eq).find('.') != std::string::npos)
+      config::apply_override(cfg, a);
+    else
+      kv[a.substr(0, eq)] = a.substr(eq + 1);
   }
   const sim::SimParams p = config::to_params(cfg);
   using clock = std::chrono::steady_clock;
@@ -62,7 +66,8 @@ int main(int argc, char** argv) {
     integrate::AdaptiveDtParams ap;
     ap.dt_max = std::stod(kv["dt_max_ns"]) * 1e-9;
     ap.dt_min = 1e-3 * ap.dt_max;
-    ap.max_displacement = 0.2 * std::min(1 / p.stepper.electro.law.kappa, p.stepper.steric.diameter);
+    ap.max_displacement =
+        0.2 * std::min(1 / p.stepper.electro.law.kappa, p.stepper.steric.diameter);
     ap.energy_tolerance = 1e-6 * p.kT;
     integrate::AdaptiveDt ctl(ap);
     const double T = std::stod(kv["implicit_ns"]) * 1e-9;
@@ -80,13 +85,15 @@ int main(int argc, char** argv) {
     const double wall = secs(t0);
     us_hour_implicit = t / 1e-6 / wall * 3600;
     const auto& tm = imp.timings();
-    std::printf("implicit: dt_max = %s ns, %.0f ns in %ld steps (%ld trials, mean dt %.3g ns), "
-                "%.3f ms/step\n", kv["dt_max_ns"].c_str(), t * 1e9, steps, trials,
-                t / steps * 1e9, 1e3 * wall / steps);
-    std::printf("implicit ms/trial: forces %.3f, stiffness %.3f, factorisation %.3f, local solve "
-                "%.3f, Stokes %.3f\n", 1e3 * tm.forces / trials, 1e3 * tm.stiffness / trials,
-                1e3 * tm.factorize / trials, 1e3 * tm.local_solve / trials,
-                1e3 * tm.stokes / trials);
+    std::printf(
+        "implicit: dt_max = %s ns, %.0f ns in %ld steps (%ld trials, mean dt %.3g ns), "
+        "%.3f ms/step\n",
+        kv["dt_max_ns"].c_str(), t * 1e9, steps, trials, t / steps * 1e9, 1e3 * wall / steps);
+    std::printf(
+        "implicit ms/trial: forces %.3f, stiffness %.3f, factorisation %.3f, local solve "
+        "%.3f, Stokes %.3f\n",
+        1e3 * tm.forces / trials, 1e3 * tm.stiffness / trials, 1e3 * tm.factorize / trials,
+        1e3 * tm.local_solve / trials, 1e3 * tm.stokes / trials);
   }
   std::printf("ratio=%.1f\n", us_hour_implicit / us_hour_explicit);
   std::printf("us_per_hour_explicit=%.4g us_per_hour_implicit=%.4g\n", us_hour_explicit,

@@ -12,29 +12,43 @@
 #include <map>
 #include <string>
 
+#include "config/config.hpp"
 #include "diagnostics/topology.hpp"
 #include "integrate/adaptive_dt.hpp"
 #include "integrate/implicit.hpp"
-#include "config/config.hpp"
 
 using namespace ibrod;
 
 int main(int argc, char** argv) {
-  std::map<std::string, std::string> kv{{"scheme", "imex"}, {"dt_ns", "1"},   {"t_end_ns", "200"},
-                                        {"out_ns", "20"},   {"beta", "2"},    {"kiter", "10"},
-                                        {"tol", "1e-2"},    {"jac_every", "1"}, {"K", "gn"}, {"steric_implicit", "1"}, {"adaptive", "0"}, {"form", "velocity"}, {"energy_every_step", "0"}, {"dmax", "2"}, {"etol", "1e-3"}};
+  std::map<std::string, std::string> kv{{"scheme", "imex"},
+                                        {"dt_ns", "1"},
+                                        {"t_end_ns", "200"},
+                                        {"out_ns", "20"},
+                                        {"beta", "2"},
+                                        {"kiter", "10"},
+                                        {"tol", "1e-2"},
+                                        {"jac_every", "1"},
+                                        {"K", "gn"},
+                                        {"steric_implicit", "1"},
+                                        {"adaptive", "0"},
+                                        {"form", "velocity"},
+                                        {"energy_every_step", "0"},
+                                        {"dmax", "2"},
+                                        {"etol", "1e-3"}};
   config::Config cfg;
   // the experiment's ring: 32³, h as at the reference (11.33 Å), 150 bp, ΔLk = 3, 0.1 M
-  for (const char* s : {"grid.n=32", "grid.box_A=362.5", "rod.base_pairs=150",
-                        "rod.excess_link=3", "run.threads=1", "run.fftw_measure=false"})
+  for (const char* s : {"grid.n=32", "grid.box_A=362.5", "rod.base_pairs=150", "rod.excess_link=3",
+                        "run.threads=1", "run.fftw_measure=false"})
     config::apply_override(cfg, s);
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const auto eq = a.find('=');
     if (eq == std::string::npos) return std::fprintf(stderr, "bad argument %s\n", a.c_str()), 2;
     const std::string k = a.substr(0, eq);
-    if (k.find('.') != std::string::npos) config::apply_override(cfg, a);
-    else kv[k] = a.substr(eq + 1);
+    if (k.find('.') != std::string::npos)
+      config::apply_override(cfg, a);
+    else
+      kv[k] = a.substr(eq + 1);
   }
   const std::string scheme = kv["scheme"];
   const double dt = std::stod(kv["dt_ns"]) * 1e-9;
@@ -69,7 +83,8 @@ int main(int argc, char** argv) {
     return e / kT;
   };
   (void)energy;
-  std::printf("# t_ns Wr Lk E_kT closest_A spacing_min spacing_max iters solves max_disp_A dt_ns\n");
+  std::printf(
+      "# t_ns Wr Lk E_kT closest_A spacing_min spacing_max iters solves max_disp_A dt_ns\n");
   const auto t0 = std::chrono::steady_clock::now();
   long steps = 0, solves = 0, iters = 0, notconv = 0;
   double res_sum = 0;
@@ -171,12 +186,15 @@ int main(int argc, char** argv) {
       "err_A=%.4g mean_residual=%.3g rejections=%ld dt_min_used_ns=%.4g\n",
       scheme.c_str(), dt * 1e9, ip.mobility_scale, steps, blown, solves,
       steps ? double(iters) / steps : 0.0, notconv, E_rise, maxdisp, wall,
-      steps ? 1e3 * wall / steps : 0.0, err, steps ? res_sum / steps : 0.0, ctl.rejections(), dt_min_used * 1e9);
+      steps ? 1e3 * wall / steps : 0.0, err, steps ? res_sum / steps : 0.0, ctl.rejections(),
+      dt_min_used * 1e9);
   if (imp) {
     const auto& tm = imp->timings();
-    std::printf("TIMINGS_ms_per_step forces=%.3f stiffness=%.3f factorize=%.3f local_solve=%.3f "
-                "stokes=%.3f\n", 1e3 * tm.forces / steps, 1e3 * tm.stiffness / steps,
-                1e3 * tm.factorize / steps, 1e3 * tm.local_solve / steps, 1e3 * tm.stokes / steps);
+    std::printf(
+        "TIMINGS_ms_per_step forces=%.3f stiffness=%.3f factorize=%.3f local_solve=%.3f "
+        "stokes=%.3f\n",
+        1e3 * tm.forces / steps, 1e3 * tm.stiffness / steps, 1e3 * tm.factorize / steps,
+        1e3 * tm.local_solve / steps, 1e3 * tm.stokes / steps);
   }
   return blown ? 1 : 0;
 }

@@ -1,8 +1,8 @@
 // `ibrod analyze` on a run directory (analyze.hpp).
 #include "analysis/analyze.hpp"
 
-#include <nlohmann/json.hpp>
 #include <toml++/toml.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cerrno>
@@ -12,12 +12,12 @@
 #include <limits>
 #include <sstream>
 
-#include "io/run_dir.hpp"
+#include "config/toml_error.hpp"
 #include "core/error.hpp"
 #include "core/text_file.hpp"
-#include "config/toml_error.hpp"
 #include "io/atomic_file.hpp"
 #include "io/h5md.hpp"
+#include "io/run_dir.hpp"
 
 namespace ibrod::analysis {
 
@@ -29,8 +29,8 @@ using json = nlohmann::ordered_json;
 namespace {
 
 FitWindow fit_window(const diagnostics::LineFit& f, std::span<const double> t, double tolerance) {
-  return {t[f.first], t[f.first + f.count - 1], f.count, f.r2, f.max_abs_residual,
-          f.max_abs_residual <= tolerance};
+  return {t[f.first], t[f.first + f.count - 1], f.count,
+          f.r2,       f.max_abs_residual,       f.max_abs_residual <= tolerance};
 }
 
 json fit_json(const std::optional<FitWindow>& f) {
@@ -44,7 +44,6 @@ json fit_json(const std::optional<FitWindow>& f) {
 }
 
 json optional_json(const std::optional<double>& v) { return v ? json(*v) : json(nullptr); }
-
 
 }  // namespace
 
@@ -113,7 +112,8 @@ Analysis analyze_timeseries(const CsvTable& table, const AnalyzeOptions& opt) {
   a.relaxation_time_table_us = a.relaxation_time_us;
   a.relaxation_time_method = "final_window";
   for (const auto& s : diagnostics::transients(t, ek, et, opt.transients))
-    a.transients.push_back({s.time, s.kinetic, s.total, wr[s.index], s.plateau_start, s.plateau_end});
+    a.transients.push_back(
+        {s.time, s.kinetic, s.total, wr[s.index], s.plateau_start, s.plateau_end});
 
   a.closest_approach_A = ca[last];
   const auto imin = std::size_t(std::min_element(ca.begin(), ca.end()) - ca.begin());
@@ -143,8 +143,8 @@ void add_contact_relaxation(Analysis& a, const CsvTable& table, ShapeAnalysis sh
   const auto ek = ts.column("E_kinetic_kT");
   const ContactHistory& c = shapes.contacts;
   if (c.time_us.empty()) {
-    a.relaxation_contacts_note = "contacts unknown: " + c.note +
-                                 "; the tables show the final-window τ (relaxation_time_us)";
+    a.relaxation_contacts_note =
+        "contacts unknown: " + c.note + "; the tables show the final-window τ (relaxation_time_us)";
   } else {
     const double settled = diagnostics::settled_time(c.time_us, c.clusters);
     a.contacts_settled_time_us = settled;
@@ -223,8 +223,8 @@ json to_json(const Analysis& a, const AnalyzeOptions& opt) {
   j["relaxation_time_method"] = a.relaxation_time_method;
   json local = json::array();
   for (const auto& w : a.local_relaxation)
-    local.push_back(json{{"t_start_us", w.t_start}, {"t_end_us", w.t_end}, {"tau_us", w.tau},
-                         {"points", w.points}});
+    local.push_back(json{
+        {"t_start_us", w.t_start}, {"t_end_us", w.t_end}, {"tau_us", w.tau}, {"points", w.points}});
   j["relaxation_time_local_us"] = local;
   j["relaxation_time_local_window_us"] = opt.tau_window_us;
   json tr = json::array();
@@ -244,8 +244,8 @@ json to_json(const Analysis& a, const AnalyzeOptions& opt) {
   j["final_energies_kT"] = e;
   j["limiting_energies_kT"] = a.equilibrium ? e : json(nullptr);
   const ShapeAnalysis& sh = a.shapes;
-  j["shape"] = sh.final_shape ? shape_json(sh.final_shape->shape, sh.final_shape->time_us)
-                              : json(nullptr);
+  j["shape"] =
+      sh.final_shape ? shape_json(sh.final_shape->shape, sh.final_shape->time_us) : json(nullptr);
   // null without --frames, so that an earlier analysis's frames do not outlive a new one
   json fr = opt.every_frame ? json::array() : json(nullptr);
   for (const auto& f : sh.frames) fr.push_back(shape_json(f.shape, f.time_us));
@@ -260,7 +260,8 @@ json to_json(const Analysis& a, const AnalyzeOptions& opt) {
     json changes = json::array();
     for (std::size_t i = 1; i < sh.contacts.time_us.size(); ++i)
       if (sh.contacts.clusters[i] != sh.contacts.clusters[i - 1])
-        changes.push_back(json{{"time_us", sh.contacts.time_us[i]}, {"clusters", sh.contacts.clusters[i]}});
+        changes.push_back(
+            json{{"time_us", sh.contacts.time_us[i]}, {"clusters", sh.contacts.clusters[i]}});
     contacts["initial_clusters"] = sh.contacts.clusters.front();
     contacts["changes"] = changes;
   }
@@ -292,8 +293,9 @@ Analysis analyze_run(const fs::path& dir, const AnalyzeOptions& opt) {
   const CsvTable table = read_csv_table(RunDir(dir).timeseries());
   Analysis a = analyze_timeseries(table, opt);
   const RunInfo info = read_run_info(dir);
-  const double dc = opt.contact_distance_A > 0 ? opt.contact_distance_A
-                                                : default_contact_distance(info.diameter_A, info.salt_M);
+  const double dc = opt.contact_distance_A > 0
+                        ? opt.contact_distance_A
+                        : default_contact_distance(info.diameter_A, info.salt_M);
   add_contact_relaxation(a, table, analyze_shapes(dir, dc, opt.every_frame), opt);
   const fs::path sp = RunDir(dir).summary();
   json summary = json::object();

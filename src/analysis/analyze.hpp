@@ -12,8 +12,8 @@
 #include <utility>
 #include <vector>
 
-#include "core/types.hpp"
 #include "analysis/shapes.hpp"
+#include "core/types.hpp"
 #include "diagnostics/relaxation.hpp"
 #include "io/csv.hpp"
 
@@ -34,9 +34,9 @@ struct RunInfo {
 RunInfo read_run_info(const std::filesystem::path& dir);
 
 struct AnalyzeOptions {
-  double writhe_delta = 0.01;           ///< δ of the writhe convergence time
-  double circular_writhe = 0.05;        ///< a run "stays circular" while |Wr| < this throughout
-  diagnostics::WindowOptions fit;              ///< final-window fits (ln E_K; tolerance in ln units)
+  double writhe_delta = 0.01;      ///< δ of the writhe convergence time
+  double circular_writhe = 0.05;   ///< a run "stays circular" while |Wr| < this throughout
+  diagnostics::WindowOptions fit;  ///< final-window fits (ln E_K; tolerance in ln units)
   diagnostics::TransientOptions transients;
   double contact_distance_A = 0;  ///< d_c of contacts and plies; 0: D + 3 λ_D of config.toml
   bool every_frame = false;       ///< `--frames`: the shape of every frame of trajectory.h5
@@ -65,8 +65,9 @@ struct Analysis {
   // require_equilibrium; analyze_timeseries alone leaves `checked` false
   bool checked = false;
   bool equilibrium = false;
-  std::string stop_reason;          ///< summary.json's, "" when unknown
-  std::string not_finished_reason;  ///< why the equilibrium quantities are null ("" if they are not)
+  std::string stop_reason;  ///< summary.json's, "" when unknown
+  std::string
+      not_finished_reason;  ///< why the equilibrium quantities are null ("" if they are not)
   std::vector<std::string> warnings;
   double writhe_final = 0;
   std::optional<double> writhe_convergence_time_us;  ///< null for an unfinished run
@@ -77,17 +78,17 @@ struct Analysis {
   std::optional<double> contacts_settled_time_us;
   std::optional<double> relaxation_time_contacts_us;
   std::optional<FitWindow> relaxation_contacts_fit;
-  std::string relaxation_contacts_note;  ///< why it is null ("" when it is not)
+  std::string relaxation_contacts_note;            ///< why it is null ("" when it is not)
   std::optional<double> relaxation_time_table_us;  ///< the τ the report's tables show
-  std::string relaxation_time_method;    ///< which: "after_last_contact" or "final_window"
+  std::string relaxation_time_method;  ///< which: "after_last_contact" or "final_window"
   std::vector<diagnostics::LocalRelaxation> local_relaxation;  ///< τ(t), windows in µs
-  ShapeAnalysis shapes;                  ///< filled by analyze_run
+  ShapeAnalysis shapes;                                        ///< filled by analyze_run
   std::vector<TransientState> transients;
-  double closest_approach_A = 0;             ///< at the last row
-  double closest_approach_min_A = 0;         ///< over the run
+  double closest_approach_A = 0;      ///< at the last row
+  double closest_approach_min_A = 0;  ///< over the run
   double closest_approach_min_time_us = 0;
   std::vector<std::pair<std::string, double>> final_energies_kT;  ///< column name, last row
-  bool stays_circular = false;               ///< |Wr| < AnalyzeOptions::circular_writhe throughout
+  bool stays_circular = false;  ///< |Wr| < AnalyzeOptions::circular_writhe throughout
   std::optional<double> kinetic_power_law_exponent;  ///< only for runs that stay circular
   std::optional<FitWindow> kinetic_power_law_fit;
 };

@@ -49,7 +49,8 @@ RodFrame read_final_state(const fs::path& dir) {
     try {
       const auto j = nlohmann::json::parse(read_text_file(sp, "analyze"));
       if (j.contains("time_us") && j["time_us"].is_number()) f.time_us = j["time_us"].get<double>();
-      if (j.contains("steps") && j["steps"].is_number_integer()) f.step = j["steps"].get<std::int64_t>();
+      if (j.contains("steps") && j["steps"].is_number_integer())
+        f.step = j["steps"].get<std::int64_t>();
     } catch (const nlohmann::json::exception&) {
       // fall through to the time series
     }
@@ -65,7 +66,8 @@ RodFrame read_final_state(const fs::path& dir) {
   return f;
 }
 
-std::vector<RodFrame> read_trajectory_frames(const fs::path& dir, std::span<const double> times_us) {
+std::vector<RodFrame> read_trajectory_frames(const fs::path& dir,
+                                             std::span<const double> times_us) {
   const fs::path p = RunDir(dir).trajectory();
   if (!fs::exists(p)) throw ConfigError("'" + p.string() + "' does not exist");
   H5mdSeries pos, d1;
@@ -156,12 +158,14 @@ std::vector<fs::path> render_run(const fs::path& dir, const RenderOptions& opt, 
       frames = read_trajectory_frames(dir, times);
       if (log)
         for (const auto& f : frames)
-          std::fprintf(log, "render: frame at t = %s us (step %lld)\n", time_label(f.time_us).c_str(),
-                       static_cast<long long>(f.step));
+          std::fprintf(log, "render: frame at t = %s us (step %lld)\n",
+                       time_label(f.time_us).c_str(), static_cast<long long>(f.step));
     } else {
       if (log)
-        std::fprintf(log, "render: no trajectory.h5 in %s: drawing the final state instead of "
-                     "--time\n", dir.c_str());
+        std::fprintf(log,
+                     "render: no trajectory.h5 in %s: drawing the final state instead of "
+                     "--time\n",
+                     dir.c_str());
       want_final = true;
     }
   }
@@ -175,7 +179,8 @@ std::vector<fs::path> render_run(const fs::path& dir, const RenderOptions& opt, 
   std::vector<fs::path> written;
   for (const auto& f : frames) {
     for (const auto& v : views) {
-      const render::Image img = render::render_rod(f.X, f.d1, info.diameter_A, v, opt.width, opt.height);
+      const render::Image img =
+          render::render_rod(f.X, f.d1, info.diameter_A, v, opt.width, opt.height);
       const fs::path file = out / ("rod_" + v.name + "_t" + time_label(f.time_us) + ".png");
       try {
         render::write_png(file.string(), img);

@@ -51,7 +51,8 @@ ShapeAnalysis analyze_shapes(const fs::path& dir, double contact_distance_A, boo
   const io::RunDir rd(dir);
   if (fs::exists(rd.final_state())) {
     const RodFrame f = read_final_state(dir);
-    if (f.X.size() >= 8) out.final_shape = ShapeRecord{f.time_us, diagnostics::analyze_shape(f.X, opt)};
+    if (f.X.size() >= 8)
+      out.final_shape = ShapeRecord{f.time_us, diagnostics::analyze_shape(f.X, opt)};
   }
   if (!fs::exists(rd.trajectory())) {
     out.contacts.note = "no trajectory.h5 (output.frame_every_steps = 0?)";

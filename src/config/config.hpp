@@ -13,9 +13,9 @@
 namespace ibrod::config {
 
 // Bounds on what a run may ask for (docs/config.md, "Bounds"); validate() refuses beyond them.
-inline constexpr double kMinDtNs = 1e-6;    ///< time.dt_ns at least 1 fs
-inline constexpr double kMaxDtNs = 1e6;     ///< time.dt_ns at most 1 ms
-inline constexpr double kMaxSteps = 1e12;   ///< time steps t_end/Δt (int64 with a wide margin)
+inline constexpr double kMinDtNs = 1e-6;   ///< time.dt_ns at least 1 fs
+inline constexpr double kMaxDtNs = 1e6;    ///< time.dt_ns at most 1 ms
+inline constexpr double kMaxSteps = 1e12;  ///< time steps t_end/Δt (int64 with a wide margin)
 inline constexpr double kMaxOutputBytes = 1125899906842624.0;  ///< 1 PiB of rows and frames
 /// Largest twist between neighbouring triads, rad: the twist strain is 2 sin(θ/2)/Δs, which is
 /// within 10% of θ/Δs for |θ| ≤ π/2 and not invertible past π (rod/rod.cpp eval_half).
@@ -25,63 +25,64 @@ inline constexpr double kMaxBoxPerRise = 1e9;
 
 struct Config {
   // [grid]
-  int grid_n = 64;                 ///< grid.n: points per box edge (even, ≥ 8)
-  double grid_box_A = 725.0;       ///< grid.box_A: periodic box edge, Å
-  int grid_kernel_width = 1;       ///< grid.kernel_width: c/h, positive integer
+  int grid_n = 64;            ///< grid.n: points per box edge (even, ≥ 8)
+  double grid_box_A = 725.0;  ///< grid.box_A: periodic box edge, Å
+  int grid_kernel_width = 1;  ///< grid.kernel_width: c/h, positive integer
   // [time]
-  double time_dt_ns = 0.1;         ///< time.dt_ns: Δt, ns
-  double time_t_end_us = 0.5;      ///< time.t_end_us: simulated time, µs
-  double time_stop_kinetic_kT = 1e-12;  ///< time.stop_kinetic_kT: stop when E_K below, kT (0: never)
-  bool time_stability_test = true;         ///< test a state before calling it an equilibrium
+  double time_dt_ns = 0.1;     ///< time.dt_ns: Δt, ns
+  double time_t_end_us = 0.5;  ///< time.t_end_us: simulated time, µs
+  double time_stop_kinetic_kT =
+      1e-12;                        ///< time.stop_kinetic_kT: stop when E_K below, kT (0: never)
+  bool time_stability_test = true;  ///< test a state before calling it an equilibrium
   double time_stability_amplitude_rad = 0.05;  ///< twist perturbation of the test, rad
   double time_stability_probe_us = 0.5;        ///< how long the perturbed copy is integrated, µs
   double time_stability_tolerance_kT = 1e-3;   ///< an energy drop beyond this: unstable, kT
   std::int64_t time_stability_seed = 1;        ///< seed of the test's perturbation
-  std::string time_scheme = "explicit";  ///< time.scheme: "explicit" | "implicit" (issue 14)
-  double time_max_displacement_A = 0;    ///< implicit: largest point move per step, Å (0: auto)
-  double time_energy_tolerance_kT = 1e-6;  ///< implicit: allowed energy rise per step, kT
-  double time_dt_min_ns = 0;             ///< implicit: smallest step, ns (0: time.dt_ns / 1000)
-  double time_implicit_mobility_scale = 8;   ///< implicit: β of M_loc
-  int time_implicit_jacobian_every = 1;      ///< implicit: steps between stiffness refreshes
-  int time_implicit_krylov_iterations = 0;   ///< implicit: GMRES iterations (0: IMEX)
-  double time_implicit_krylov_tol = 1e-2;    ///< implicit: GMRES relative residual
+  std::string time_scheme = "explicit";        ///< time.scheme: "explicit" | "implicit" (issue 14)
+  double time_max_displacement_A = 0;       ///< implicit: largest point move per step, Å (0: auto)
+  double time_energy_tolerance_kT = 1e-6;   ///< implicit: allowed energy rise per step, kT
+  double time_dt_min_ns = 0;                ///< implicit: smallest step, ns (0: time.dt_ns / 1000)
+  double time_implicit_mobility_scale = 8;  ///< implicit: β of M_loc
+  int time_implicit_jacobian_every = 1;     ///< implicit: steps between stiffness refreshes
+  int time_implicit_krylov_iterations = 0;  ///< implicit: GMRES iterations (0: IMEX)
+  double time_implicit_krylov_tol = 1e-2;   ///< implicit: GMRES relative residual
   // [rod]
-  int rod_base_pairs = 600;        ///< rod.base_pairs: rod points n
-  int rod_excess_link = 6;         ///< rod.excess_link: ΔLk (integer)
-  std::vector<double> rod_perturbation{1.0};  ///< rod.perturbation: ε_m, m = 1, 2, …, rad
+  int rod_base_pairs = 600;                         ///< rod.base_pairs: rod points n
+  int rod_excess_link = 6;                          ///< rod.excess_link: ΔLk (integer)
+  std::vector<double> rod_perturbation{1.0};        ///< rod.perturbation: ε_m, m = 1, 2, …, rad
   rod::RandomPerturbation rod_perturbation_random;  ///< rod.perturbation_random: drawn ε_m, added
-  double rod_rise_A = 3.4;         ///< rod.rise_A: Δs, Å
-  double rod_bend_modulus_erg_cm = 1.3e-19;   ///< a1 = a2, erg·cm
-  double rod_twist_modulus_erg_cm = 1.82e-19; ///< a3, erg·cm
-  double rod_shear_modulus_dyn = 5e-5;        ///< b1 = b2, dyn
-  double rod_stretch_modulus_dyn = 5e-5;      ///< b3, dyn
-  double rod_intrinsic_twist_per_A = 0.0;     ///< Ω³₀, rad/Å
+  double rod_rise_A = 3.4;                          ///< rod.rise_A: Δs, Å
+  double rod_bend_modulus_erg_cm = 1.3e-19;         ///< a1 = a2, erg·cm
+  double rod_twist_modulus_erg_cm = 1.82e-19;       ///< a3, erg·cm
+  double rod_shear_modulus_dyn = 5e-5;              ///< b1 = b2, dyn
+  double rod_stretch_modulus_dyn = 5e-5;            ///< b3, dyn
+  double rod_intrinsic_twist_per_A = 0.0;           ///< Ω³₀, rad/Å
   // [solvent]
-  double solvent_salt_M = 0.1;          ///< Cs, mol/L
+  double solvent_salt_M = 0.1;  ///< Cs, mol/L
   double solvent_viscosity_poise = 0.01;
   double solvent_density_g_cm3 = 1.0;
   double solvent_temperature_K = 300.0;
-  bool solvent_advection = true;        ///< include the nonlinear advection term
+  bool solvent_advection = true;  ///< include the nonlinear advection term
   // [electrostatics]
   bool electrostatics_enabled = true;
-  double electrostatics_charge_e = 0.48;     ///< charge per base pair, e
-  double electrostatics_dielectric = 77.7;   ///< εw
-  double electrostatics_cutoff_debye = 0;    ///< set from interactions::kDefaultCutoffDebye
+  double electrostatics_charge_e = 0.48;    ///< charge per base pair, e
+  double electrostatics_dielectric = 77.7;  ///< εw
+  double electrostatics_cutoff_debye = 0;   ///< set from interactions::kDefaultCutoffDebye
   // [steric]
   bool steric_enabled = true;
-  double steric_diameter_A = 20.0;      ///< D, Å
-  double steric_stiffness_kT_A2 = 0;    ///< g, kT/Å²; set from interactions::kDefaultStericStiffness
+  double steric_diameter_A = 20.0;    ///< D, Å
+  double steric_stiffness_kT_A2 = 0;  ///< g, kT/Å²; set from interactions::kDefaultStericStiffness
   // [output]
   std::int64_t output_every_steps = 1000;      ///< output.every_steps: steps between rows
   std::int64_t output_frame_every_steps = -1;  ///< steps between trajectory frames; 0: none;
                                                ///< −1: same as output.every_steps (frame_every())
   std::int64_t output_checkpoint_every_steps = 10000;  ///< steps between checkpoints; 0: only at
                                                        ///< start, end and on SIGINT/SIGTERM
-  bool output_fluid_vti = false;               ///< fluid velocity .vti with every frame
-  bool output_fluid_velocity = false;          ///< DIR/velocity.npy at the end (io/npy.hpp)
+  bool output_fluid_vti = false;                       ///< fluid velocity .vti with every frame
+  bool output_fluid_velocity = false;                  ///< DIR/velocity.npy at the end (io/npy.hpp)
   // [run]
-  int run_threads = 0;                  ///< 0: OpenMP default (OMP_NUM_THREADS or all cores)
-  bool run_fftw_measure = true;         ///< FFTW_MEASURE plans (false: FFTW_ESTIMATE)
+  int run_threads = 0;           ///< 0: OpenMP default (OMP_NUM_THREADS or all cores)
+  bool run_fftw_measure = true;  ///< FFTW_MEASURE plans (false: FFTW_ESTIMATE)
 
   Config();
 };
@@ -94,7 +95,8 @@ std::int64_t frame_every(const Config& c);
 void apply_toml(Config& c, const std::string& toml_text, const std::string& source_name);
 /// Load a TOML file on top of the defaults (an empty path: defaults only).
 Config load_config(const std::string& path);
-/// Apply one `section.key=value` override; value is TOML (numbers, true/false, [arrays], "strings").
+/// Apply one `section.key=value` override; value is TOML (numbers, true/false, [arrays],
+/// "strings").
 void apply_override(Config& c, const std::string& assignment);
 /// Cross-key checks (ring fits in the box, kernel fits in the grid, …); throws ConfigError.
 void validate(const Config& c);

@@ -22,12 +22,15 @@ inline std::string echo(const std::string& v, std::size_t max = 80) {
   for (std::size_t i = 0; i < v.size(); ++i) {
     if (out.size() >= max) return out + "…";
     const unsigned char ch = static_cast<unsigned char>(v[i]);
-    if (ch == '\n') out += "\\n";
-    else if (ch == '\t') out += "\\t";
+    if (ch == '\n')
+      out += "\\n";
+    else if (ch == '\t')
+      out += "\\t";
     else if (ch < 0x20 || ch == 0x7f) {
       static const char hex[] = "0123456789abcdef";
       out += std::string("\\x") + hex[ch >> 4] + hex[ch & 15];
-    } else out += char(ch);
+    } else
+      out += char(ch);
   }
   return out;
 }

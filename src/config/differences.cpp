@@ -12,8 +12,8 @@ std::string config_differences(const std::string& old_toml, const Config& now,
   try {
     apply_toml(old, old_toml, source);
   } catch (const ConfigError& e) {
-    return std::string("the checkpoint's configuration cannot be read by this ibrod (") +
-           e.what() + ")";
+    return std::string("the checkpoint's configuration cannot be read by this ibrod (") + e.what() +
+           ")";
   }
   std::istringstream a(describe(old)), b(describe(now));
   std::string la, lb, out;

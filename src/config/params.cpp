@@ -35,13 +35,11 @@ void validate(const Config& c) {
   if (2 * r0 + c.steric_diameter_A >= c.grid_box_A)
     bad("grid.box_A", fmt(c.grid_box_A),
         "a box larger than the ring: rod.base_pairs = " + std::to_string(c.rod_base_pairs) +
-            " at rod.rise_A = " + fmt(c.rod_rise_A) + " gives a ring of diameter " +
-            fmt(2 * r0) + " Å (plus the hard core steric.diameter_A = " +
-            fmt(c.steric_diameter_A) + " Å)");
+            " at rod.rise_A = " + fmt(c.rod_rise_A) + " gives a ring of diameter " + fmt(2 * r0) +
+            " Å (plus the hard core steric.diameter_A = " + fmt(c.steric_diameter_A) + " Å)");
   if (c.grid_box_A > kMaxBoxPerRise * c.rod_rise_A)
     bad("grid.box_A", fmt(c.grid_box_A),
-        "at most " + fmt(kMaxBoxPerRise) + " rod.rise_A = " +
-            fmt(kMaxBoxPerRise * c.rod_rise_A) +
+        "at most " + fmt(kMaxBoxPerRise) + " rod.rise_A = " + fmt(kMaxBoxPerRise * c.rod_rise_A) +
             " Å (positions of that size keep 6 digits of a segment in double precision)");
   if (c.time_scheme == "implicit" && c.time_dt_min_ns > c.time_dt_ns)
     bad("time.dt_min_ns", fmt(c.time_dt_min_ns),
@@ -55,8 +53,8 @@ void validate(const Config& c) {
   if (!(steps <= kMaxSteps))
     bad("time.t_end_us", fmt(c.time_t_end_us),
         "at most " + fmt(kMaxSteps) + " time steps of time.dt_ns = " + fmt(c.time_dt_ns) +
-            " ns, i.e. time.t_end_us <= " + fmt(kMaxSteps * c.time_dt_ns * 1e-3) + " (asked: " +
-            fmt(steps) + " steps)");
+            " ns, i.e. time.t_end_us <= " + fmt(kMaxSteps * c.time_dt_ns * 1e-3) +
+            " (asked: " + fmt(steps) + " steps)");
   if (const double bytes = output_estimate_bytes(c); !(bytes <= kMaxOutputBytes)) {
     const bool frames = frame_every(c) > 0;
     bad(frames ? "output.frame_every_steps" : "output.every_steps",
@@ -85,7 +83,6 @@ void validate(const Config& c) {
         "a link small enough that the twisted circle exists (|sin β| = " + fmt(std::abs(sin_beta)) +
             " >= 1)");
 }
-
 
 sim::SimParams to_params(const Config& c) {
   using namespace units;
@@ -133,8 +130,8 @@ sim::SimParams to_params(const Config& c) {
   p.output.checkpoints = c.output_checkpoint_every_steps;
   // issue 14: the implicit scheme (docs/large_dt.md); its dt_max is p.dt, its automatic
   // max_displacement and dt_min are resolved by sim::Simulation
-  p.scheme = c.time_scheme == "implicit" ? sim::TimeScheme::implicit_step
-                                         : sim::TimeScheme::explicit_step;
+  p.scheme =
+      c.time_scheme == "implicit" ? sim::TimeScheme::implicit_step : sim::TimeScheme::explicit_step;
   p.adaptive.max_displacement = c.time_max_displacement_A * angstrom;
   p.adaptive.energy_tolerance = c.time_energy_tolerance_kT * p.kT;
   p.adaptive.dt_min = c.time_dt_min_ns * ns;
@@ -145,7 +142,6 @@ sim::SimParams to_params(const Config& c) {
   return p;
 }
 
-
 double memory_estimate_bytes(const Config& c, int ranks) {
   const double n = c.grid_n;
   // velocity + force (3 real arrays each) + spectrum (3 complex half arrays), split over ranks
@@ -154,7 +150,6 @@ double memory_estimate_bytes(const Config& c, int ranks) {
   const double program = 32.0 * (1 << 20);
   return fluid + 400.0 * c.rod_base_pairs + program;
 }
-
 
 double output_estimate_bytes(const Config& c) {
   const double steps = std::ceil(c.time_t_end_us * 1e3 / c.time_dt_ns);
@@ -167,7 +162,6 @@ double output_estimate_bytes(const Config& c) {
   const double frame = 366.0 * c.rod_base_pairs + (c.output_fluid_vti ? 32.0 * n * n * n : 0);
   return rows * 400.0 + frames * frame;
 }
-
 
 std::string derived_report(const Config& c) {
   const auto p = to_params(c);
@@ -212,17 +206,21 @@ std::vector<std::string> check_warnings(const Config& c) {
   const auto p = to_params(c);
   const double h = p.stepper.grid.h();
   if (c.steric_enabled && h > c.steric_diameter_A)
-    w.push_back("the grid spacing h = " + fmt(h) + " Å (grid.box_A / grid.n) exceeds the hard-core "
-                "diameter steric.diameter_A = " + fmt(c.steric_diameter_A) +
+    w.push_back("the grid spacing h = " + fmt(h) +
+                " Å (grid.box_A / grid.n) exceeds the hard-core "
+                "diameter steric.diameter_A = " +
+                fmt(c.steric_diameter_A) +
                 " Å: the fluid cannot resolve strands in contact (raise grid.n)");
   const double r0 = rod::circle_radius(c.rod_base_pairs, c.rod_rise_A);
   const double kappa = p.stepper.electro.law.kappa;
   if (c.electrostatics_enabled && kappa > 0) {
     const double need = 2 * r0 + c.steric_diameter_A + 3.0 / kappa;
     if (c.grid_box_A < need)
-      w.push_back("the box grid.box_A = " + fmt(c.grid_box_A) + " Å leaves less than 3 Debye "
-                  "lengths (3/κ = " + fmt(3.0 / kappa) + " Å) between the ring (diameter " +
-                  fmt(2 * r0) + " Å) and its periodic images: they interact (raise grid.box_A)");
+      w.push_back("the box grid.box_A = " + fmt(c.grid_box_A) +
+                  " Å leaves less than 3 Debye "
+                  "lengths (3/κ = " +
+                  fmt(3.0 / kappa) + " Å) between the ring (diameter " + fmt(2 * r0) +
+                  " Å) and its periodic images: they interact (raise grid.box_A)");
   }
   return w;
 }

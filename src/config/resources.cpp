@@ -49,7 +49,6 @@ void lower(double& best, std::string* why, double v, const char* name) {
 
 }  // namespace
 
-
 double memory_available_bytes(std::string* why) {
   double best = double(::sysconf(_SC_PHYS_PAGES)) * double(::sysconf(_SC_PAGESIZE));
   if (why) *why = "physical memory";
@@ -65,7 +64,6 @@ double memory_available_bytes(std::string* why) {
   return best;
 }
 
-
 void check_memory(const Config& c, int ranks) {
   std::string why;
   const double need = memory_estimate_bytes(c, ranks);
@@ -73,8 +71,7 @@ void check_memory(const Config& c, int ranks) {
   if (need <= have) return;
   // blame the rod only when it, not the grid, is what does not fit
   const bool rod = 400.0 * c.rod_base_pairs > 0.5 * need;
-  detail::bad(rod ? "rod.base_pairs" : "grid.n",
-              std::to_string(rod ? c.rod_base_pairs : c.grid_n),
+  detail::bad(rod ? "rod.base_pairs" : "grid.n", std::to_string(rod ? c.rod_base_pairs : c.grid_n),
               "a run that fits in memory: it needs about " + detail::fmt(std::ceil(need / MiB)) +
                   " MiB (ibrod check: memory estimate) but this process may allocate " +
                   detail::fmt(std::floor(have / MiB)) + " MiB (" + why + ")");

@@ -14,9 +14,8 @@ namespace ibrod::config {
 inline ConfigError toml_syntax_error(const std::string& what, const std::string& source,
                                      const toml::parse_error& e) {
   std::ostringstream os;
-  os << what << ": " << source << ":" << e.source().begin.line << ":"
-     << e.source().begin.column << ": TOML syntax error: "
-     << detail::echo(std::string(e.description()), 200);
+  os << what << ": " << source << ":" << e.source().begin.line << ":" << e.source().begin.column
+     << ": TOML syntax error: " << detail::echo(std::string(e.description()), 200);
   return ConfigError(os.str());
 }
 

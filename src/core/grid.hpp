@@ -7,14 +7,17 @@
 namespace ibrod {
 
 struct GridSpec {
-  int n = 64;          ///< points per edge
-  double L = 725.0;    ///< box edge, Å
+  int n = 64;        ///< points per edge
+  double L = 725.0;  ///< box edge, Å
 
   double h() const { return L / n; }  ///< grid spacing, Å
   std::size_t size() const { return std::size_t(n) * n * n; }
   std::size_t index(int i, int j, int k) const { return (std::size_t(i) * n + j) * n + k; }
   /// periodic wrap of an integer index into [0, n)
-  int wrap(int i) const { int r = i % n; return r < 0 ? r + n : r; }
+  int wrap(int i) const {
+    int r = i % n;
+    return r < 0 ? r + n : r;
+  }
 };
 
 }  // namespace ibrod

@@ -20,11 +20,11 @@ inline constexpr double nm = 10.0 * angstrom;
 inline constexpr double ns = 1e-9 * second;
 inline constexpr double us = 1e-6 * second;
 // derived CGS units
-inline constexpr double dyn = gram * cm / (second * second);          ///< 1e8 g Å s⁻²
-inline constexpr double erg = dyn * cm;                               ///< 1e16 g Å² s⁻²
-inline constexpr double erg_cm = erg * cm;                            ///< bending modulus unit, 1e24 g Å³ s⁻²
-inline constexpr double poise = gram / (cm * second);                 ///< 1e-8 g Å⁻¹ s⁻¹
-inline constexpr double g_per_cm3 = gram / (cm * cm * cm);            ///< 1e-24 g Å⁻³
+inline constexpr double dyn = gram * cm / (second * second);  ///< 1e8 g Å s⁻²
+inline constexpr double erg = dyn * cm;                       ///< 1e16 g Å² s⁻²
+inline constexpr double erg_cm = erg * cm;             ///< bending modulus unit, 1e24 g Å³ s⁻²
+inline constexpr double poise = gram / (cm * second);  ///< 1e-8 g Å⁻¹ s⁻¹
+inline constexpr double g_per_cm3 = gram / (cm * cm * cm);  ///< 1e-24 g Å⁻³
 
 // physical constants
 inline constexpr double boltzmann = 1.380649e-16 * erg;  ///< k_B per kelvin, g Å² s⁻² K⁻¹

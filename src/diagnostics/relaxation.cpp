@@ -64,8 +64,7 @@ LineFit fit_line(std::span<const double> x, std::span<const double> y) {
   return f;
 }
 
-std::optional<LineFit> fit_final_linear_window(std::span<const double> x,
-                                               std::span<const double> y,
+std::optional<LineFit> fit_final_linear_window(std::span<const double> x, std::span<const double> y,
                                                const WindowOptions& opt) {
   require_same_size(x, y, "fit_final_linear_window");
   const std::size_t n = x.size();
@@ -79,7 +78,8 @@ std::optional<LineFit> fit_final_linear_window(std::span<const double> x,
   // grow geometrically until a window fails …
   std::size_t good = lmin, bad = 0;
   while (good < n) {
-    const std::size_t len = std::min(n, std::max(good + 1, std::size_t(std::ceil(1.05 * double(good)))));
+    const std::size_t len =
+        std::min(n, std::max(good + 1, std::size_t(std::ceil(1.05 * double(good)))));
     LineFit f = fit_len(len);
     if (!passes(f)) {
       bad = len;
@@ -129,8 +129,8 @@ std::optional<ExponentialFit> relaxation_time(std::span<const double> t,
                                               const WindowOptions& opt) {
   require_same_size(t, kinetic, "relaxation_time");
   const std::size_t n = t.size();
-  const std::size_t start =
-      final_run_start(n, [&](std::size_t i) { return kinetic[i] > 0 && std::isfinite(kinetic[i]); });
+  const std::size_t start = final_run_start(
+      n, [&](std::size_t i) { return kinetic[i] > 0 && std::isfinite(kinetic[i]); });
   std::vector<double> lnE(n - start);
   for (std::size_t i = start; i < n; ++i) lnE[i - start] = std::log(kinetic[i]);
   const auto fit = fit_final_linear_window(t.subspan(start), lnE, opt);
@@ -143,8 +143,8 @@ std::optional<ExponentialFit> relaxation_time(std::span<const double> t,
 }
 
 std::optional<ExponentialFit> relaxation_time_from(std::span<const double> t,
-                                                   std::span<const double> kinetic,
-                                                   double t_start, std::size_t min_points) {
+                                                   std::span<const double> kinetic, double t_start,
+                                                   std::size_t min_points) {
   require_same_size(t, kinetic, "relaxation_time_from");
   std::vector<double> x, y;
   std::size_t first = t.size();
@@ -165,8 +165,7 @@ std::optional<ExponentialFit> relaxation_time_from(std::span<const double> t,
 }
 
 std::vector<LocalRelaxation> local_relaxation_times(std::span<const double> t,
-                                                    std::span<const double> kinetic,
-                                                    double width) {
+                                                    std::span<const double> kinetic, double width) {
   require_same_size(t, kinetic, "local_relaxation_times");
   if (!(width > 0)) throw std::invalid_argument("local_relaxation_times: width must be positive");
   std::vector<LocalRelaxation> out;
@@ -205,9 +204,8 @@ std::optional<PowerLawFit> power_law_exponent(std::span<const double> t,
                                               const WindowOptions& opt) {
   require_same_size(t, kinetic, "power_law_exponent");
   const std::size_t n = t.size();
-  const std::size_t start = final_run_start(n, [&](std::size_t i) {
-    return t[i] > 0 && kinetic[i] > 0 && std::isfinite(kinetic[i]);
-  });
+  const std::size_t start = final_run_start(
+      n, [&](std::size_t i) { return t[i] > 0 && kinetic[i] > 0 && std::isfinite(kinetic[i]); });
   std::vector<double> lnt(n - start), lnE(n - start);
   for (std::size_t i = start; i < n; ++i) {
     lnt[i - start] = std::log(t[i]);
@@ -259,7 +257,8 @@ std::vector<Transient> transients(std::span<const double> t, std::span<const dou
 
     // plateau of E_total: slow dissipation relative to the active phases on either side
     const std::size_t i0 = v[k], a = v[lpeak], b = v[rpeak];
-    const double rmax = *std::max_element(rate.begin() + std::ptrdiff_t(a), rate.begin() + std::ptrdiff_t(b) + 1);
+    const double rmax =
+        *std::max_element(rate.begin() + std::ptrdiff_t(a), rate.begin() + std::ptrdiff_t(b) + 1);
     const double threshold = opt.plateau_fraction * rmax;
     if (!(rate[i0] <= threshold)) continue;
     std::size_t lo = i0, hi = i0;

@@ -40,8 +40,7 @@ struct WindowOptions {
 /// cost is O(n log n). If even the shortest window fails, that window is returned (its
 /// max_abs_residual then exceeds the tolerance: the caller reports it). nullopt when n <
 /// min_points. x, y finite.
-std::optional<LineFit> fit_final_linear_window(std::span<const double> x,
-                                               std::span<const double> y,
+std::optional<LineFit> fit_final_linear_window(std::span<const double> x, std::span<const double> y,
                                                const WindowOptions& opt = {});
 
 /// Writhe convergence time: the largest t at which |Wr(t) − Wr(∞)| > delta, with Wr(∞) the last
@@ -69,8 +68,8 @@ std::optional<ExponentialFit> relaxation_time(std::span<const double> t,
 /// E_K > 0 — the approach after the last contact formed (docs/analysis.md). nullopt with fewer
 /// than min_points such samples or when E_K does not decay there (slope ≥ 0).
 std::optional<ExponentialFit> relaxation_time_from(std::span<const double> t,
-                                                   std::span<const double> kinetic,
-                                                   double t_start, std::size_t min_points = 5);
+                                                   std::span<const double> kinetic, double t_start,
+                                                   std::size_t min_points = 5);
 
 /// τ(t) = −2 / (d ln E_K / dt) over one window of the series.
 struct LocalRelaxation {
@@ -82,8 +81,7 @@ struct LocalRelaxation {
 /// τ(t) on consecutive windows [t_0 + k·width, t_0 + (k+1)·width) that hold at least 3 samples
 /// with E_K > 0 (others are skipped); slope 0 (flat E_K) gives no entry. width > 0.
 std::vector<LocalRelaxation> local_relaxation_times(std::span<const double> t,
-                                                    std::span<const double> kinetic,
-                                                    double width);
+                                                    std::span<const double> kinetic, double width);
 
 /// When a sampled count stops changing: the time of the first sample after its last change,
 /// t.front() if it never changes. t and count the same size, not empty.
@@ -110,12 +108,12 @@ struct TransientOptions {
 
 /// A transient state: the rod lingers near an unstable equilibrium.
 struct Transient {
-  std::size_t index = 0;       ///< sample of the E_K minimum
-  double time = 0;             ///< t at the minimum
-  double kinetic = 0;          ///< E_K at the minimum
-  double total = 0;            ///< E_total at the minimum (the plateau's energy)
-  double plateau_start = 0;    ///< t where the plateau (|dE_total/dt| below the threshold around
-  double plateau_end = 0;      ///< the minimum) begins and ends
+  std::size_t index = 0;     ///< sample of the E_K minimum
+  double time = 0;           ///< t at the minimum
+  double kinetic = 0;        ///< E_K at the minimum
+  double total = 0;          ///< E_total at the minimum (the plateau's energy)
+  double plateau_start = 0;  ///< t where the plateau (|dE_total/dt| below the threshold around
+  double plateau_end = 0;    ///< the minimum) begins and ends
 };
 
 /// Local minima of E_K (only samples with E_K > 0 count) whose prominence in E_K is at least

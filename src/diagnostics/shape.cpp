@@ -74,11 +74,16 @@ struct UnionFind {
 
 const char* shape_class_name(ShapeClass c) {
   switch (c) {
-    case ShapeClass::circle: return "circle";
-    case ShapeClass::figure8: return "figure-8";
-    case ShapeClass::plectonemic: return "plectonemic";
-    case ShapeClass::toroidal: return "toroidal";
-    case ShapeClass::other: return "other";
+    case ShapeClass::circle:
+      return "circle";
+    case ShapeClass::figure8:
+      return "figure-8";
+    case ShapeClass::plectonemic:
+      return "plectonemic";
+    case ShapeClass::toroidal:
+      return "toroidal";
+    case ShapeClass::other:
+      return "other";
   }
   return "other";
 }
@@ -120,7 +125,8 @@ int projected_crossings(std::span<const Vec3> X, const Vec3& direction) {
       const int j = order[b];
       if (cyclic_distance(i, j, n) < 2) continue;  // adjacent edges share a vertex
       const Eigen::Vector2d &q0 = P[j], &q1 = P[(j + 1) % n];
-      if (orient(p0, p1, q0) * orient(p0, p1, q1) < 0 && orient(q0, q1, p0) * orient(q0, q1, p1) < 0)
+      if (orient(p0, p1, q0) * orient(p0, p1, q1) < 0 &&
+          orient(q0, q1, p0) * orient(q0, q1, p1) < 0)
         ++crossings;
     }
   }

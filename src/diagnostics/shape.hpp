@@ -1,8 +1,9 @@
 #pragma once
 // The shape of a closed rod (issue 15 item 2; criteria in docs/analysis.md "Shapes"): crossings
-// in the projection with fewest crossings (and the most frequent count), lobes, two-ply (interwound) runs, contacts, and the
-// class (circle, figure-8, plectonemic, toroidal, other). Pure functions of the centreline
-// X_0 … X_{n−1} (closed: X_n = X_0), Å, assumed about evenly spaced (a rod). O(n²) at most.
+// in the projection with fewest crossings (and the most frequent count), lobes, two-ply
+// (interwound) runs, contacts, and the class (circle, figure-8, plectonemic, toroidal, other). Pure
+// functions of the centreline X_0 … X_{n−1} (closed: X_n = X_0), Å, assumed about evenly spaced (a
+// rod). O(n²) at most.
 #include <span>
 #include <string>
 #include <utility>

@@ -54,7 +54,7 @@ inline double row_solid_angle(const Vec3& p1, const Vec3& p2, const Vec3* Y, int
     const double T = a.dot(u.cross(s));
     const double den1 = ra * rd * rc + ad * rc + ac * rd + dc * ra;  // triangle (a, d, c)
     const double den2 = ra * rc * rb + ac * rb + ab * rc + bc * ra;  // triangle (a, c, b)
-    sum += std::atan2(T * (den1 + den2), den1 * den2 - T * T);      // = Ω/2
+    sum += std::atan2(T * (den1 + den2), den1 * den2 - T * T);       // = Ω/2
     a = b;
     d = c;
     ra = rb;
@@ -126,7 +126,8 @@ double linking_number(std::span<const Vec3> A, std::span<const Vec3> B) {
 // Indiana Univ. Math. J. 25 (1976) 1171, for polygons).
 double twist(std::span<const Vec3> X, std::span<const Vec3> d1) {
   const int n = int(X.size());
-  if (int(d1.size()) != n) throw std::invalid_argument("diagnostics::twist: X and d1 differ in length");
+  if (int(d1.size()) != n)
+    throw std::invalid_argument("diagnostics::twist: X and d1 differ in length");
   if (n < 3) return 0.0;
   std::vector<Vec3> t(n);
   for (int k = 0; k < n; ++k) t[k] = (X[(k + 1) % n] - X[k]).normalized();
@@ -135,9 +136,9 @@ double twist(std::span<const Vec3> X, std::span<const Vec3> d1) {
     const int kn = (k + 1) % n;
     const Vec3& tk = t[k];
     const Vec3& tn = t[kn];
-    const Vec3 u = d1[k] - d1[k].dot(tk) * tk;     // ribbon at the start of edge k
-    const Vec3 v = d1[kn] - d1[kn].dot(tk) * tk;   // … at its end
-    const Vec3 w = d1[kn] - d1[kn].dot(tn) * tn;   // … at the start of edge k+1
+    const Vec3 u = d1[k] - d1[k].dot(tk) * tk;    // ribbon at the start of edge k
+    const Vec3 v = d1[kn] - d1[kn].dot(tk) * tk;  // … at its end
+    const Vec3 w = d1[kn] - d1[kn].dot(tn) * tn;  // … at the start of edge k+1
     angle += signed_angle(u, v, tk);
     // R v = v + c×v + c×(c×v)/(1 + t_k·t_{k+1}), c = t_k × t_{k+1} (Rodrigues, sinθ = |c|)
     const Vec3 c = tk.cross(tn);

@@ -19,7 +19,8 @@ double writhe(std::span<const Vec3> X);
 /// small ε. O(n).
 /// Exactly, with t_k the unit tangent of edge X_k → X_{k+1}, P_k(v) = v − (v·t_k) t_k, R_k the
 /// minimal rotation taking t_{k−1} to t_k, and ∠_t(p, q) ∈ (−π, π] the right-handed angle about t:
-///   2π Tw = Σ_k ∠_{t_k}(P_k d1_k, P_k d1_{k+1}) + ∠_{t_{k+1}}(R_{k+1} P_k d1_{k+1}, P_{k+1} d1_{k+1}).
+///   2π Tw = Σ_k ∠_{t_k}(P_k d1_k, P_k d1_{k+1}) + ∠_{t_{k+1}}(R_{k+1} P_k d1_{k+1}, P_{k+1}
+///   d1_{k+1}).
 /// d1 need be neither unit nor ⟂ to the edges (it is projected), but must not lie along one, and
 /// its projection must turn by less than π per edge and per vertex. d1.size() ≠ X.size() throws
 /// std::invalid_argument.

@@ -100,7 +100,8 @@ BenchResult bench(const Config& c, int steps) {
 }
 
 void print_bench(const Config& c, const BenchResult& r, std::FILE* out) {
-  std::fprintf(out, "ibrod bench: %d³ grid, %d rod points, Cs = %g M, electrostatics %s, steric %s, "
+  std::fprintf(out,
+               "ibrod bench: %d³ grid, %d rod points, Cs = %g M, electrostatics %s, steric %s, "
                "%d threads, %d steps\n",
                c.grid_n, c.rod_base_pairs, c.solvent_salt_M,
                c.electrostatics_enabled ? "on" : "off", c.steric_enabled ? "on" : "off", r.threads,
@@ -113,8 +114,7 @@ void print_bench(const Config& c, const BenchResult& r, std::FILE* out) {
   for (const auto& ph : r.phases)
     std::fprintf(out, "%-22s %10.4f %7.1f%%\n", ph.name.c_str(), ph.ms, 100 * ph.ms / sum);
   std::fprintf(out, "%-22s %10.4f\n", "sum of phases", sum);
-  std::fprintf(out, "%-22s %10.4f   (the three fluid passes)\n",
-               "fluid solve", r.fluid_solve_ms);
+  std::fprintf(out, "%-22s %10.4f   (the three fluid passes)\n", "fluid solve", r.fluid_solve_ms);
   std::fprintf(out, "%-22s %10.4f\n", "full step", r.step_ms);
   std::fprintf(out, "%-22s %10.4f   (FFTW's threaded 3-D r2c + c2r plans, 3 components)\n",
                "FFTs alone, FFTW 3-D", r.fftw3d_ms);

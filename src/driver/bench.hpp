@@ -18,12 +18,12 @@ struct BenchResult {
   std::vector<BenchPhase> phases;  ///< rod forces, pair forces, spreading, the 3 fluid passes, …
   double step_ms = 0;              ///< full Stepper::step, timed on its own
   double fluid_solve_ms = 0;       ///< the three passes of FluidSolver::finish_step()
-  double fftw3d_ms = 0;   ///< FFTW's threaded 3-D r2c + c2r plans alone (3 components each)
+  double fftw3d_ms = 0;     ///< FFTW's threaded 3-D r2c + c2r plans alone (3 components each)
   double split_fft_ms = 0;  ///< the step's own split transforms alone (run_split_ffts_only)
   /// the FFT-only time the ratio is taken against: the faster of the two, so that neither a slow
   /// reference nor a slow decomposition can flatter the ratio
   double fft_ms = 0;
-  double diagnostics_ms = 0;       ///< one observe() (output steps only)
+  double diagnostics_ms = 0;  ///< one observe() (output steps only)
   int steps = 0, threads = 0;
   double ratio() const { return step_ms / fft_ms; }
 };

@@ -13,8 +13,8 @@ double seconds_since(Clock::time_point t) {
 }
 }  // namespace
 
-SchemeBenchResult bench_schemes(const config::Config& c, int explicit_steps,
-                                double implicit_dt_ns, double implicit_ns) {
+SchemeBenchResult bench_schemes(const config::Config& c, int explicit_steps, double implicit_dt_ns,
+                                double implicit_ns) {
   SchemeBenchResult r;
   config::Config ce = c;
   ce.time_scheme = "explicit";
@@ -59,8 +59,8 @@ void print_bench_schemes(const SchemeBenchResult& r, std::FILE* out) {
                r.explicit_steps, r.explicit_dt_ns, r.explicit_ms_per_step, r.implicit_ns,
                r.implicit_steps, r.implicit_dt_max_ns, r.implicit_ns / double(r.implicit_steps),
                r.implicit_rejections, r.implicit_ms_per_step, r.ratio());
-  std::fprintf(out, "us_per_hour_explicit=%.4g us_per_hour_implicit=%.4g\n",
-               r.us_per_hour_explicit, r.us_per_hour_implicit);
+  std::fprintf(out, "us_per_hour_explicit=%.4g us_per_hour_implicit=%.4g\n", r.us_per_hour_explicit,
+               r.us_per_hour_implicit);
 }
 
 }  // namespace ibrod::driver

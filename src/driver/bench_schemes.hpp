@@ -9,7 +9,7 @@
 namespace ibrod::driver {
 
 struct SchemeBenchResult {
-  double explicit_dt_ns = 0;      ///< the explicit step (time.dt_ns of the config)
+  double explicit_dt_ns = 0;  ///< the explicit step (time.dt_ns of the config)
   int explicit_steps = 0;
   double explicit_ms_per_step = 0;
   double implicit_dt_max_ns = 0;  ///< the implicit scheme's largest step
@@ -23,8 +23,8 @@ struct SchemeBenchResult {
 /// `explicit_steps` explicit steps of time.dt_ns (after 10 untimed ones), then `implicit_ns` of
 /// simulated time with time.scheme = "implicit" and time.dt_ns = implicit_dt_ns (the other keys
 /// as configured), both from the configured initial state.
-SchemeBenchResult bench_schemes(const config::Config& c, int explicit_steps,
-                                double implicit_dt_ns, double implicit_ns);
+SchemeBenchResult bench_schemes(const config::Config& c, int explicit_steps, double implicit_dt_ns,
+                                double implicit_ns);
 /// Prints the two; the last line is `us_per_hour_explicit=… us_per_hour_implicit=…`.
 void print_bench_schemes(const SchemeBenchResult& r, std::FILE* out);
 

@@ -44,7 +44,8 @@ DirLock::DirLock(const std::filesystem::path& dir) {
       throw ConfigError("output: " + dir.string() + " is being written by another ibrod process" +
                         (holder ? " (PID " + std::to_string(*holder) + ")" : std::string()) +
                         "; one writer per run directory: wait for it to finish, or stop it "
-                        "(then continue with --resume " + dir.string() + ")");
+                        "(then continue with --resume " +
+                        dir.string() + ")");
     throw RunError("output: cannot lock " + path.string() + ": " + std::strerror(err));
   }
   const std::string pid = std::to_string(::getpid()) + "\n";

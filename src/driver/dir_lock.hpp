@@ -4,10 +4,10 @@
 // that process ends, however it ends (exit, crash, kill -9). The lock file holds the holder's PID,
 // so that a second writer is refused with a message that names it; a lock file left by a process
 // that has died is no lock (flock is not held), and is simply taken over.
+#include <sys/types.h>
 #include <filesystem>
 #include <optional>
 #include <string>
-#include <sys/types.h>
 
 namespace ibrod::driver {
 

@@ -13,7 +13,6 @@
 
 namespace ibrod::driver::mpi {
 
-
 bool available() {
 #ifdef IBROD_MPI
   return true;
@@ -23,8 +22,7 @@ bool available() {
 }
 
 bool launched() {
-  return std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMI_SIZE") ||
-         std::getenv("PMIX_RANK");
+  return std::getenv("OMPI_COMM_WORLD_SIZE") || std::getenv("PMI_SIZE") || std::getenv("PMIX_RANK");
 }
 
 World init([[maybe_unused]] int* argc, [[maybe_unused]] char*** argv) {
@@ -133,6 +131,5 @@ void on_root(int rank, int ranks, const std::function<void()>& f) {
   if (kind == 3) throw RunError(what);
   throw std::runtime_error(what);
 }
-
 
 }  // namespace ibrod::driver::mpi

@@ -4,7 +4,6 @@
 
 namespace ibrod::driver {
 
-
 Progress::Progress(std::FILE* out, int tty, double interval_s, double tty_interval_s)
     : out_(out),
       tty_(out && (tty < 0 ? ::isatty(::fileno(out)) != 0 : tty != 0)),

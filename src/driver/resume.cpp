@@ -13,7 +13,6 @@ namespace ibrod::driver {
 
 namespace fs = std::filesystem;
 
-
 // Whether every final file of a run that stopped for `stop_reason` is there: summary.json with
 // that stop_reason, final_state.csv, velocity.npy if asked for.
 bool Run::State::final_files_complete(const std::string& stop_reason) const {
@@ -26,7 +25,6 @@ bool Run::State::final_files_complete(const std::string& stop_reason) const {
   return true;
 }
 
-
 // --resume: the checkpoint must fit the configuration (the grid and the rod exactly; any other
 // key only with --force). A run that already stopped and is resumed unchanged has nothing to do.
 void Run::State::open_checkpoint() {
@@ -37,22 +35,23 @@ void Run::State::open_checkpoint() {
   if (!fs::exists(cp, ec))
     throw ConfigError("resume: " + cp.string() +
                       " does not exist (the run stopped before its first checkpoint, or '" +
-                      dir.root().string() + "' is not an ibrod output directory); start it again "
+                      dir.root().string() +
+                      "' is not an ibrod output directory); start it again "
                       "with --overwrite");
   checkpoint = io::read_checkpoint(cp);
   const io::Checkpoint& ck = *checkpoint;
   if (ck.grid_n != c.grid_n || ck.rod.size() != c.rod_base_pairs)
-    throw ConfigError("resume: " + cp.string() + " holds a " + std::to_string(ck.grid_n) +
-                      "³ grid and " + std::to_string(ck.rod.size()) +
-                      " rod points; the configuration asks for grid.n = " +
-                      std::to_string(c.grid_n) + " and rod.base_pairs = " +
-                      std::to_string(c.rod_base_pairs) + ": incompatible, even with --force");
+    throw ConfigError(
+        "resume: " + cp.string() + " holds a " + std::to_string(ck.grid_n) + "³ grid and " +
+        std::to_string(ck.rod.size()) + " rod points; the configuration asks for grid.n = " +
+        std::to_string(c.grid_n) + " and rod.base_pairs = " + std::to_string(c.rod_base_pairs) +
+        ": incompatible, even with --force");
   const std::string diff = config::config_differences(ck.meta.config_toml, user, cp.string());
   config_changed = !diff.empty();
   // a later t_end alone extends the run: the continuation is the uninterrupted longer run
-  extension = config_changed && config::only_end_time_extended(ck.meta.config_toml, user, cp.string());
-  if (extension)
-    say("ibrod: extending the run in " + dir.root().string() + " (" + diff + ")");
+  extension =
+      config_changed && config::only_end_time_extended(ck.meta.config_toml, user, cp.string());
+  if (extension) say("ibrod: extending the run in " + dir.root().string() + " (" + diff + ")");
   if (config_changed && !opt.force && !extension)
     throw ConfigError("resume: the configuration differs from the one " + cp.string() +
                       " was written with (" + diff +
@@ -73,16 +72,18 @@ void Run::State::open_checkpoint() {
                   static_cast<long long>(ck.meta.step));
     throw ConfigError(buf);
   }
-  if (ck.meta.stop_reason != "none" && !config_changed && !final_files_complete(ck.meta.stop_reason)) {
+  if (ck.meta.stop_reason != "none" && !config_changed &&
+      !final_files_complete(ck.meta.stop_reason)) {
     // killed after its final checkpoint, before its final files: write them now
     say("ibrod: the run in " + dir.root().string() + " stopped (" + ck.meta.stop_reason +
-        ") at step " + std::to_string(ck.meta.step) + " but its final files are incomplete; "
+        ") at step " + std::to_string(ck.meta.step) +
+        " but its final files are incomplete; "
         "writing them");
     complete_only = true;
     stopped_reason = sim::stop_reason_from(ck.meta.stop_reason);
   } else if (ck.meta.stop_reason != "none" && !config_changed) {
-    say("ibrod: the run in " + dir.root().string() + " already stopped (" +
-        ck.meta.stop_reason + ") at step " + std::to_string(ck.meta.step) + "; nothing to do");
+    say("ibrod: the run in " + dir.root().string() + " already stopped (" + ck.meta.stop_reason +
+        ") at step " + std::to_string(ck.meta.step) + "; nothing to do");
     result.already_finished = true;
     result.steps = ck.meta.step;
     result.initial = ck.meta.initial;
@@ -93,7 +94,6 @@ void Run::State::open_checkpoint() {
   // the same threads as the run that wrote the checkpoint: the same round-off
   if (c.run_threads == 0) c.run_threads = ck.meta.threads;
 }
-
 
 void Run::State::restore_state() {
   if (checkpoint) {
@@ -119,7 +119,6 @@ void Run::State::restore_state() {
   wall_before = meta.wall_s;
 }
 
-
 RunResult Run::State::complete() {
   loop_start = Clock::now();
   start_step = sim->step_count();
@@ -129,6 +128,5 @@ RunResult Run::State::complete() {
   finish(last_row, to_string(stopped_reason), "");
   return result;
 }
-
 
 }  // namespace ibrod::driver

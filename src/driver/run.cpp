@@ -47,7 +47,8 @@ std::string format_g(double v, int digits = 6) {
 void Run::State::check_launch() const {
   if (distributed && c.grid_n % opt.ranks != 0)
     throw ConfigError("run: grid.n = " + std::to_string(c.grid_n) + " cannot be split over " +
-                      std::to_string(opt.ranks) + " MPI ranks: each rank holds grid.n/K x-planes "
+                      std::to_string(opt.ranks) +
+                      " MPI ranks: each rank holds grid.n/K x-planes "
                       "of the fluid, so the rank count K of `mpirun -np K` must divide grid.n");
   if (distributed && !fluid::distributed_available())
     throw ConfigError("run: this ibrod was built without FFTW MPI; run it without mpirun");
@@ -108,10 +109,10 @@ void Run::State::open_files() {
   // free space kept in hand: a checkpoint (written beside the previous one), a few frames
   // (H5MD + .vtp, ~300 B per point, + the .vti) and 16 MiB of slack
   const std::uintmax_t n = std::uintmax_t(c.grid_n);
-  reserve_bytes = 24 * n * n * n +
-                  4 * (300u * std::uintmax_t(c.rod_base_pairs) +
-                       (c.output_fluid_vti ? 48u * n * n * n : 0u)) +
-                  (std::uintmax_t(16) << 20);
+  reserve_bytes =
+      24 * n * n * n +
+      4 * (300u * std::uintmax_t(c.rod_base_pairs) + (c.output_fluid_vti ? 48u * n * n * n : 0u)) +
+      (std::uintmax_t(16) << 20);
 }
 
 void Run::State::announce() {
@@ -185,8 +186,8 @@ void Run::State::finish(const sim::Observables& o, const std::string& stop_reaso
   r.link_drift = o.link - r.initial.link;
   r.max_link_drift = meta.max_link_drift;
   r.self_passage_warning = meta.self_passage_warning;
-  const bool npy = error.empty() && stop_reason != to_string(StopReason::interrupted) &&
-                   c.output_fluid_velocity;
+  const bool npy =
+      error.empty() && stop_reason != to_string(StopReason::interrupted) && c.output_fluid_velocity;
   std::array<const double*, 3> u{};
   if (npy) u = sim->stepper().whole_velocity(gathered);
   on_root([&] {
@@ -204,7 +205,8 @@ void Run::State::blow_up(const std::string& what) {
                 static_cast<long long>(sim->step_count()), sim->time() / 1e-6);
   std::string msg = buf + what +
                     ". The time step is probably too large for the stretch/shear stiffness "
-                    "(time.dt_ns = " + format_g(c.time_dt_ns) +
+                    "(time.dt_ns = " +
+                    format_g(c.time_dt_ns) +
                     "): try a smaller time.dt_ns, or check the moduli and forces.";
   if (result.checkpoint_step >= 0)
     msg += " The last good checkpoint (step " + std::to_string(result.checkpoint_step) +
@@ -222,8 +224,8 @@ sim::Observables Run::State::observe_checked() {
   // E_total includes E_K = ½ρΣ|u|²h³, so a NaN/Inf anywhere in the fluid shows here (the rod
   // itself is checked after every step by rod_problem)
   if (!std::isfinite(o.E_total_kT))
-    blow_up("the fluid velocity or an energy is not finite (E_total = " +
-            format_g(o.E_total_kT) + " kT, E_K = " + format_g(o.E_kinetic_kT) + " kT)");
+    blow_up("the fluid velocity or an energy is not finite (E_total = " + format_g(o.E_total_kT) +
+            " kT, E_K = " + format_g(o.E_kinetic_kT) + " kT)");
   return o;
 }
 

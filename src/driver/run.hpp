@@ -28,13 +28,13 @@ namespace ibrod::driver {
 
 struct RunOptions {
   std::string output_dir = "ibrod-out";
-  bool overwrite = false;     ///< replace the files of an existing, non-empty output directory
-  bool resume = false;        ///< continue the run in output_dir from its checkpoint.bin
-  bool force = false;         ///< resume even if the configuration differs from the checkpoint's
-  std::string fftw_wisdom;    ///< import these FFTW plans before planning ("": none)
-  bool handle_signals = true; ///< SIGINT/SIGTERM: checkpoint at the end of the step, then return
-  std::FILE* log = stdout;    ///< progress lines and warnings (nullptr: silent)
-  int tty = -1;               ///< progress style: 1 in place ('\r'), 0 plain lines, −1 isatty(log)
+  bool overwrite = false;      ///< replace the files of an existing, non-empty output directory
+  bool resume = false;         ///< continue the run in output_dir from its checkpoint.bin
+  bool force = false;          ///< resume even if the configuration differs from the checkpoint's
+  std::string fftw_wisdom;     ///< import these FFTW plans before planning ("": none)
+  bool handle_signals = true;  ///< SIGINT/SIGTERM: checkpoint at the end of the step, then return
+  std::FILE* log = stdout;     ///< progress lines and warnings (nullptr: silent)
+  int tty = -1;  ///< progress style: 1 in place ('\r'), 0 plain lines, −1 isatty(log)
   /// MPI rank and rank count of MPI_COMM_WORLD (`mpirun -np K ibrod run`, driver/mpi_env.hpp): with
   /// ranks > 1 the fluid grid is split over the ranks (fluid::DistributedFluid), every rank runs
   /// the rod and the loop, and rank 0 alone writes files and progress. Every rank must call run().
@@ -47,14 +47,14 @@ struct RunResult {
   double time_us = 0;
   sim::StopReason reason = sim::StopReason::none;
   sim::Observables initial, final;
-  double wall_s = 0;          ///< this process
-  double ms_per_step = 0;     ///< this process
-  int signal = 0;             ///< SIGINT/SIGTERM that stopped the run after a checkpoint; 0: none
-  bool already_finished = false;  ///< --resume of a run that had stopped: nothing was done
-  std::int64_t resumed_from = -1; ///< checkpoint step this process started from (−1: fresh)
+  double wall_s = 0;       ///< this process
+  double ms_per_step = 0;  ///< this process
+  int signal = 0;          ///< SIGINT/SIGTERM that stopped the run after a checkpoint; 0: none
+  bool already_finished = false;      ///< --resume of a run that had stopped: nothing was done
+  std::int64_t resumed_from = -1;     ///< checkpoint step this process started from (−1: fresh)
   std::int64_t checkpoint_step = -1;  ///< step of the latest checkpoint written or read
-  double link_drift = 0;      ///< final Lk − initial Lk
-  double max_link_drift = 0;  ///< max |Lk − Lk(0)| over the output steps
+  double link_drift = 0;              ///< final Lk − initial Lk
+  double max_link_drift = 0;          ///< max |Lk − Lk(0)| over the output steps
   bool self_passage_warning = false;  ///< max_link_drift > kLinkDriftWarning
 };
 

@@ -37,7 +37,8 @@ void prepare_output_dir(const io::RunDir& run_dir, bool overwrite, std::optional
   if (holds_files && !overwrite)
     throw ConfigError("output: directory '" + dir.string() +
                       "' already holds files; choose another -o DIR, pass --overwrite, or "
-                      "continue a stopped run with --resume " + dir.string());
+                      "continue a stopped run with --resume " +
+                      dir.string());
   if (overwrite) {
     // stale frames or a stale checkpoint of an earlier run must not mix with this one
     for (const fs::path& f : run_dir.run_files()) fs::remove_all(f, ec);
@@ -65,8 +66,8 @@ std::string summary_json(const config::Config& c, const RunResult& r, const Chec
   j["ms_per_step"] = r.ms_per_step;
   j["total_wall_time_s"] = meta.wall_s;
   j["threads"] = meta.threads;
-  j["resumed_from_step"] =
-      r.resumed_from >= 0 ? nlohmann::ordered_json(r.resumed_from) : nlohmann::ordered_json(nullptr);
+  j["resumed_from_step"] = r.resumed_from >= 0 ? nlohmann::ordered_json(r.resumed_from)
+                                               : nlohmann::ordered_json(nullptr);
   j["resumes"] = meta.resumes;
   j["checkpoint_step"] = r.checkpoint_step >= 0 ? nlohmann::ordered_json(r.checkpoint_step)
                                                 : nlohmann::ordered_json(nullptr);

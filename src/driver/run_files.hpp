@@ -55,19 +55,20 @@ class RunFiles {
     const int n = sim.rod().size();
     if (resume_step < 0) {
       io::write_file_atomic(ts, io::timeseries_header() + "\n");
-      if (frames_on_)
-        h5_ = io::H5mdWriter::create(dir.trajectory(), n, c.grid_box_A, config_text);
+      if (frames_on_) h5_ = io::H5mdWriter::create(dir.trajectory(), n, c.grid_box_A, config_text);
     } else {
-      io::write_file_atomic(ts, io::timeseries_up_to(try_read_text_file(ts).value_or(""),
-                                             io::timeseries_header(), resume_step, ts.string()));
+      io::write_file_atomic(
+          ts, io::timeseries_up_to(try_read_text_file(ts).value_or(""), io::timeseries_header(),
+                                   resume_step, ts.string()));
       if (frame_step < 0) frame_step = resume_step;
-      if (frames_on_) reopen_trajectory(dir.trajectory(), n, c.grid_box_A, frame_step,
-                                        config_text, progress);
+      if (frames_on_)
+        reopen_trajectory(dir.trajectory(), n, c.grid_box_A, frame_step, config_text, progress);
       if (frames_on_) rod_pvd_.resume(frame_step);
       if (frames_on_ && vti_) fluid_pvd_.resume(frame_step);
     }
     ts_ = std::fopen(ts.c_str(), "a");
-    if (!ts_) throw RunError("output: cannot open " + ts.string() + ": " + io::io_error_text(errno));
+    if (!ts_)
+      throw RunError("output: cannot open " + ts.string() + ": " + io::io_error_text(errno));
   }
   ~RunFiles() {
     if (ts_) std::fclose(ts_);
@@ -84,8 +85,11 @@ class RunFiles {
     std::error_code ec;
     const std::filesystem::space_info space = std::filesystem::space(dir_.root(), ec);
     if (!ec && space.available < bytes)
-      throw RunError("output: only " + std::to_string(space.available >> 20) + " MiB left on the "
-                     "device of " + dir_.root().string() + " (disk full?); stopped before writing, so "
+      throw RunError("output: only " + std::to_string(space.available >> 20) +
+                     " MiB left on the "
+                     "device of " +
+                     dir_.root().string() +
+                     " (disk full?); stopped before writing, so "
                      "every file is intact: free space and " +
                      (has_checkpoint ? "continue with --resume " + dir_.root().string()
                                      : "start the run again with --overwrite (it stopped before "
@@ -142,6 +146,5 @@ class RunFiles {
 };
 
 // ---------------------------------------------------------------------------------------------
-
 
 }  // namespace ibrod::driver

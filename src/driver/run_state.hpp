@@ -36,15 +36,15 @@ struct AlreadyFinished {};
 // Everything one run holds between its steps. Under MPI (ranks > 1) rank 0 alone writes (files
 // is null elsewhere); every write goes through on_root so that a failure there stops every rank.
 struct Run::State {
-  config::Config user;   // as given (config.toml is written from it)
-  config::Config c;      // as run (threads resolved on resume)
+  config::Config user;  // as given (config.toml is written from it)
+  config::Config c;     // as run (threads resolved on resume)
   RunOptions opt;
   io::RunDir dir;
   std::string config_text;
   Clock::time_point t0 = Clock::now();
   bool distributed = false;
   Progress progress;
-  std::optional<DirLock> lock;               // rank 0: held while the run writes dir
+  std::optional<DirLock> lock;  // rank 0: held while the run writes dir
 
   std::optional<io::Checkpoint> checkpoint;  // the one to continue from, until it is applied
   bool config_changed = false;
@@ -54,15 +54,15 @@ struct Run::State {
   bool complete_only = false;
   StopReason stopped_reason = StopReason::none;
   std::optional<sim::Simulation> sim;
-  std::unique_ptr<RunFiles> files;           // rank 0 only
-  std::vector<double> gathered;              // distributed: the whole velocity on rank 0
+  std::unique_ptr<RunFiles> files;  // rank 0 only
+  std::vector<double> gathered;     // distributed: the whole velocity on rank 0
   io::CheckpointMeta meta;
   RunResult result;
-  double wall_before = 0;                    // wall time of the earlier segments, s
+  double wall_before = 0;  // wall time of the earlier segments, s
   Clock::time_point loop_start;
   std::int64_t start_step = 0;
   std::uintmax_t reserve_bytes = 0;
-  sim::Observables last_row;                 // the row of the latest output step
+  sim::Observables last_row;  // the row of the latest output step
 
   State(const config::Config& cfg, const RunOptions& o)
       : user(cfg),

@@ -29,7 +29,8 @@ class SignalGuard {
 
  private:
   bool on_;
-  struct sigaction old_int_ {}, old_term_ {};
+  struct sigaction old_int_ {
+  }, old_term_{};
 };
 
 /// "SIGINT", "SIGTERM" or "a signal".

@@ -128,7 +128,8 @@ void flatten(const toml::table& t, const std::string& prefix,
              std::vector<std::pair<std::string, const toml::array*>>& out,
              const std::string& where) {
   for (auto&& [k, v] : t) {
-    const std::string key = prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
+    const std::string key =
+        prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
     if (const toml::table* sub = v.as_table()) {
       flatten(*sub, key, out, where);
       continue;
@@ -138,7 +139,8 @@ void flatten(const toml::table& t, const std::string& prefix,
       throw ConfigError(where + ": [sweep] " + key + " = " + toml_text(v) +
                         " is invalid: expected a list of values, e.g. [1, 2, 3]");
     if (a->empty())
-      throw ConfigError(where + ": [sweep] " + key + " is an empty list: expected at least one value");
+      throw ConfigError(where + ": [sweep] " + key +
+                        " is an empty list: expected at least one value");
     for (const auto& [other, _] : out)
       if (other == key) throw ConfigError(where + ": [sweep] " + key + " is given twice");
     out.emplace_back(key, a);
@@ -150,8 +152,9 @@ void flatten(const toml::table& t, const std::string& prefix,
 std::string sanitize_name(const std::string& s) {
   std::string out = s;
   for (char& ch : out) {
-    const bool ok = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') ||
-                    ch == '.' || ch == '_' || ch == '+' || ch == '=' || ch == ',' || ch == '-';
+    const bool ok = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') ||
+                    (ch >= '0' && ch <= '9') || ch == '.' || ch == '_' || ch == '+' || ch == '=' ||
+                    ch == ',' || ch == '-';
     if (!ok) ch = '-';
   }
   if (out.empty() || out[0] == '.') out = "_" + out;  // no hidden or empty names
@@ -178,18 +181,23 @@ Sweep parse_sweep(const std::string& text, const std::string& source, const fs::
   const toml::table* names = nullptr;
   if (const toml::node* b = doc.get("base")) {
     auto path = b->value_exact<std::string>();
-    if (!path) throw ConfigError(where + ": base = " + toml_text(*b) + " is invalid: expected a file name (string)");
+    if (!path)
+      throw ConfigError(where + ": base = " + toml_text(*b) +
+                        " is invalid: expected a file name (string)");
     const fs::path p = fs::path(*path).is_absolute() ? fs::path(*path) : dir / *path;
     tree = parse_table(read_text_file(p, where + ": base = \"" + *path + "\""), p.string());
     if (tree.contains("sweep") || tree.contains("base"))
-      throw ConfigError(where + ": base = \"" + *path + "\" must be a plain config (no [sweep], no base)");
+      throw ConfigError(where + ": base = \"" + *path +
+                        "\" must be a plain config (no [sweep], no base)");
   }
   for (auto&& [k, v] : doc) {
     const std::string key(k.str());
     if (key == "base") continue;
     if (key == "output_dir") {
       auto o = v.value_exact<std::string>();
-      if (!o || o->empty()) throw ConfigError(where + ": output_dir = " + toml_text(v) + " is invalid: expected a directory name (string)");
+      if (!o || o->empty())
+        throw ConfigError(where + ": output_dir = " + toml_text(v) +
+                          " is invalid: expected a directory name (string)");
       sw.output_root = *o;
       continue;
     }
@@ -205,8 +213,9 @@ Sweep parse_sweep(const std::string& text, const std::string& source, const fs::
       deep_merge(tree, overlay);
       continue;
     }
-    throw ConfigError(where + ": unknown top-level key '" + key +
-                      "' (a sweep file has base, output_dir, [names], [sweep] and config sections)");
+    throw ConfigError(
+        where + ": unknown top-level key '" + key +
+        "' (a sweep file has base, output_dir, [names], [sweep] and config sections)");
   }
   if (!sweep_table || sweep_table->empty())
     throw ConfigError(where + ": no [sweep] table: expected [sweep] with key = [values…]");
@@ -229,7 +238,8 @@ Sweep parse_sweep(const std::string& text, const std::string& source, const fs::
   for (const auto& [key, _] : lists) ++leaf_count[default_short_name(key)];
   for (const auto& [key, arr] : lists) {
     if (key.find('.') == std::string::npos)
-      throw ConfigError(where + ": [sweep] '" + key + "' is not a config key: expected section.key");
+      throw ConfigError(where + ": [sweep] '" + key +
+                        "' is not a config key: expected section.key");
     SweepAxis ax;
     ax.key = key;
     ax.short_name = default_short_name(key);
@@ -241,7 +251,8 @@ Sweep parse_sweep(const std::string& text, const std::string& source, const fs::
     if (names)
       if (const toml::node* nm = names->get(key)) {
         auto s = nm->value_exact<std::string>();
-        if (!s || s->empty()) throw ConfigError(where + ": [names] \"" + key + "\" must be a non-empty string");
+        if (!s || s->empty())
+          throw ConfigError(where + ": [names] \"" + key + "\" must be a non-empty string");
         ax.short_name = *s;
       }
     for (const toml::node& v : *arr) {
@@ -262,7 +273,8 @@ Sweep parse_sweep(const std::string& text, const std::string& source, const fs::
       bool found = false;
       for (const auto& ax : sw.axes) found = found || ax.key == k.str();
       if (!found)
-        throw ConfigError(where + ": [names] \"" + std::string(k.str()) + "\" is not a key of [sweep]");
+        throw ConfigError(where + ": [names] \"" + std::string(k.str()) +
+                          "\" is not a key of [sweep]");
     }
 
   // ---- the product, first axis slowest

@@ -34,12 +34,12 @@ struct SweepPoint {
   std::size_t index = 0;  ///< position in the product (first axis slowest)
   std::string name;       ///< directory name: "dlk=4_salt_M=0.1"
   std::vector<std::pair<std::string, std::string>> assignments;  ///< key → TOML value text
-  config::Config config;          ///< resolved and validated
+  config::Config config;                                         ///< resolved and validated
 };
 
 struct Sweep {
-  std::string source;               ///< the sweep file (for messages)
-  std::string output_root;          ///< `output_dir = …` of the file ("" if absent)
+  std::string source;       ///< the sweep file (for messages)
+  std::string output_root;  ///< `output_dir = …` of the file ("" if absent)
   std::vector<SweepAxis> axes;
   std::vector<SweepPoint> points;
 };

@@ -9,11 +9,11 @@
 #include <algorithm>
 #include <cerrno>
 #include <charconv>
+#include <chrono>
+#include <csignal>
 #include <cstring>
 #include <map>
 #include <sstream>
-#include <chrono>
-#include <csignal>
 #include <thread>
 
 #include <nlohmann/json.hpp>
@@ -31,15 +31,20 @@ using namespace ibrod::io;
 
 namespace fs = std::filesystem;
 
-
 const char* to_string(PointState s) {
   switch (s) {
-    case PointState::fresh: return "fresh";
-    case PointState::no_checkpoint: return "no_checkpoint";
-    case PointState::interrupted: return "interrupted";
-    case PointState::finished: return "finished";
-    case PointState::failed: return "failed";
-    case PointState::running: return "running";
+    case PointState::fresh:
+      return "fresh";
+    case PointState::no_checkpoint:
+      return "no_checkpoint";
+    case PointState::interrupted:
+      return "interrupted";
+    case PointState::finished:
+      return "finished";
+    case PointState::failed:
+      return "failed";
+    case PointState::running:
+      return "running";
   }
   return "?";
 }
@@ -128,7 +133,8 @@ std::string last_line(const fs::path& log) {
   std::size_t e = text.find_last_not_of("\r\n ");
   if (e == std::string::npos) return "";
   std::size_t b = text.find_last_of("\r\n", e);
-  return text.substr(b == std::string::npos ? 0 : b + 1, e - (b == std::string::npos ? 0 : b + 1) + 1);
+  return text.substr(b == std::string::npos ? 0 : b + 1,
+                     e - (b == std::string::npos ? 0 : b + 1) + 1);
 }
 
 }  // namespace
@@ -140,7 +146,8 @@ SweepReport run_sweep(const Sweep& sw, const SweepOptions& opt) {
   std::error_code ec;
   fs::create_directories(sweep_dir.configs(), ec);
   fs::create_directories(sweep_dir.logs(), ec);
-  if (ec) throw RunError("sweep: cannot create '" + sweep_dir.logs().string() + "': " + ec.message());
+  if (ec)
+    throw RunError("sweep: cannot create '" + sweep_dir.logs().string() + "': " + ec.message());
   if (opt.only_point < 0) {
     if (opt.rank == 0) write_file_atomic(sweep_dir.points(), points_csv(sw));
   } else if (!fs::exists(sweep_dir.points(), ec)) {
@@ -191,8 +198,9 @@ SweepReport run_sweep(const Sweep& sw, const SweepOptions& opt) {
     if (st == PointState::finished || st == PointState::interrupted) {
       // a directory of an earlier, different sweep: never resume or count it as this point
       if (try_read_text_file(RunDir(dir).config()).value_or("") != config_text) {
-        fail(pt, "the run in " + dir.string() + " has another configuration than this sweep "
-                 "gives the point; move it away (or delete it) to run the point again");
+        fail(pt, "the run in " + dir.string() +
+                     " has another configuration than this sweep "
+                     "gives the point; move it away (or delete it) to run the point again");
         continue;
       }
     }
@@ -209,7 +217,8 @@ SweepReport run_sweep(const Sweep& sw, const SweepOptions& opt) {
     todo.push_back({&pt, st});
   }
   say(tag + std::to_string(rep.points) + " points" +
-      (ranks > 1 ? " (rank " + std::to_string(opt.rank) + " of " + std::to_string(ranks) + ")" : "") +
+      (ranks > 1 ? " (rank " + std::to_string(opt.rank) + " of " + std::to_string(ranks) + ")"
+                 : "") +
       ": " + std::to_string(rep.skipped) + " finished, " + std::to_string(todo.size()) +
       " to run, " + std::to_string(jobs) + " at a time -> " + root.string());
 
@@ -252,9 +261,9 @@ SweepReport run_sweep(const Sweep& sw, const SweepOptions& opt) {
       }
       (resume ? rep.resumed : rep.fresh)++;
       running[pid] = {t.pt, std::chrono::steady_clock::now(), resume};
-      say(tag + "[" + std::to_string(next) + "/" + std::to_string(todo.size()) + "] " +
-          t.pt->name + ": " + (resume ? "resuming from its checkpoint" : "started") + " (log " +
-          log.string() + ")");
+      say(tag + "[" + std::to_string(next) + "/" + std::to_string(todo.size()) + "] " + t.pt->name +
+          ": " + (resume ? "resuming from its checkpoint" : "started") + " (log " + log.string() +
+          ")");
     }
     if (running.empty()) break;
     int status = 0;
@@ -288,8 +297,7 @@ SweepReport run_sweep(const Sweep& sw, const SweepOptions& opt) {
     }
   }
   say(tag + "done: " + std::to_string(rep.completed) + " finished now, " +
-      std::to_string(rep.skipped) + " already finished, " + std::to_string(rep.failed) +
-      " failed" +
+      std::to_string(rep.skipped) + " already finished, " + std::to_string(rep.failed) + " failed" +
       (rep.running ? ", " + std::to_string(rep.running) + " still running elsewhere" : "") +
       (rep.signal ? ", stopped by a signal" : ""));
   return rep;

@@ -21,19 +21,22 @@ struct SweepDir {
   std::filesystem::path points() const { return root / "points.csv"; }
   std::filesystem::path configs() const { return root / "configs"; }
   std::filesystem::path logs() const { return root / "logs"; }
-  std::filesystem::path config(const std::string& name) const { return configs() / (name + ".toml"); }
+  std::filesystem::path config(const std::string& name) const {
+    return configs() / (name + ".toml");
+  }
   std::filesystem::path log(const std::string& name) const { return logs() / (name + ".log"); }
   std::filesystem::path run(const std::string& name) const { return root / name; }
 };
 
 /// What a point's directory holds.
 enum class PointState {
-  fresh,        ///< absent or empty: run it
-  no_checkpoint,  ///< files but no checkpoint (killed before the first one): run it with --overwrite
-  interrupted,  ///< a checkpoint and no final summary: `ibrod run --resume`
-  finished,     ///< summary.json says end_time or equilibrium: skip
-  failed,       ///< summary.json says blow_up: not run again (delete the directory to retry)
-  running,      ///< another process holds the directory's lock (driver/dir_lock.hpp): not started
+  fresh,          ///< absent or empty: run it
+  no_checkpoint,  ///< files but no checkpoint (killed before the first one): run it with
+                  ///< --overwrite
+  interrupted,    ///< a checkpoint and no final summary: `ibrod run --resume`
+  finished,       ///< summary.json says end_time or equilibrium: skip
+  failed,         ///< summary.json says blow_up: not run again (delete the directory to retry)
+  running,        ///< another process holds the directory's lock (driver/dir_lock.hpp): not started
 };
 PointState point_state(const std::filesystem::path& dir);
 const char* to_string(PointState s);
@@ -49,14 +52,14 @@ struct SweepOptions {
 };
 
 struct SweepReport {
-  int points = 0;       ///< this rank's share
-  int skipped = 0;      ///< already finished
-  int fresh = 0;        ///< started from the beginning
-  int resumed = 0;      ///< continued from a checkpoint
-  int completed = 0;    ///< finished by this invocation
-  int failed = 0;       ///< failed now or before (blow-up), or stale
-  int running = 0;      ///< written by another process (its lock is held): not started
-  int signal = 0;       ///< SIGINT/SIGTERM that stopped the sweep (0: none)
+  int points = 0;     ///< this rank's share
+  int skipped = 0;    ///< already finished
+  int fresh = 0;      ///< started from the beginning
+  int resumed = 0;    ///< continued from a checkpoint
+  int completed = 0;  ///< finished by this invocation
+  int failed = 0;     ///< failed now or before (blow-up), or stale
+  int running = 0;    ///< written by another process (its lock is held): not started
+  int signal = 0;     ///< SIGINT/SIGTERM that stopped the sweep (0: none)
   std::vector<std::string> failed_names;
 };
 

@@ -20,9 +20,9 @@ namespace {
 // assign: r_c = a u_c − b S_h(u)_c instead of r_c += …; a run-time flag, because target_clones
 // does not combine with templates, but the two loops below are separate, so both vectorise.
 IBROD_TARGET_CLONES void advect_row(int n, const double* const* c, const double* const* xp,
-                                 const double* const* xm, const double* const* yp,
-                                 const double* const* ym, double* const* r, double a, double b4,
-                                 bool assign) {
+                                    const double* const* xm, const double* const* yp,
+                                    const double* const* ym, double* const* r, double a, double b4,
+                                    bool assign) {
   const double *u0 = c[0], *u1 = c[1], *u2 = c[2];
   const double *x0p = xp[0], *x1p = xp[1], *x2p = xp[2];
   const double *x0m = xm[0], *x1m = xm[1], *x2m = xm[2];
@@ -65,10 +65,9 @@ IBROD_TARGET_CLONES void advect_row(int n, const double* const* c, const double*
 
 }  // namespace
 
-void rhs_plane(int n, double h, const int* next, const int* prev,
-               std::array<const double*, 3> uc, std::array<const double*, 3> uxp,
-               std::array<const double*, 3> uxm, std::array<double*, 3> r, double a, double b,
-               bool assign) {
+void rhs_plane(int n, double h, const int* next, const int* prev, std::array<const double*, 3> uc,
+               std::array<const double*, 3> uxp, std::array<const double*, 3> uxm,
+               std::array<double*, 3> r, double a, double b, bool assign) {
   const std::size_t nz = std::size_t(n);
   // S_h carries 1/(4h): ½ from the skew average, ½h from each central difference.
   const double b4 = b / (4.0 * h);

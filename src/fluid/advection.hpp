@@ -30,10 +30,9 @@ inline void make_neighbour_tables(int n, std::vector<int>& next, std::vector<int
 /// one plane, layout j·n + k. uc, uxp, uxm: the three velocity components on this plane and on
 /// the planes at x + h and x − h; r: the three output planes (must not overlap u). next/prev:
 /// make_neighbour_tables(n) (the y and z neighbours wrap periodically within the plane). h in Å.
-void rhs_plane(int n, double h, const int* next, const int* prev,
-               std::array<const double*, 3> uc, std::array<const double*, 3> uxp,
-               std::array<const double*, 3> uxm, std::array<double*, 3> r, double a, double b,
-               bool assign);
+void rhs_plane(int n, double h, const int* next, const int* prev, std::array<const double*, 3> uc,
+               std::array<const double*, 3> uxp, std::array<const double*, 3> uxm,
+               std::array<double*, 3> r, double a, double b, bool assign);
 
 /// At every grid point, r_c += a·u_c − b·S_h(u)_c (c = 0, 1, 2). In the fluid step a = ρ/Δt
 /// (g Å⁻³ s⁻¹) and b = ρ (g Å⁻³), u in Å s⁻¹, r in g Å⁻² s⁻². b == 0 skips the advection

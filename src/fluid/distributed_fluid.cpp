@@ -84,9 +84,9 @@ DistributedFluid::DistributedFluid(const GridSpec& grid, const FluidParams& para
   // y in the transposed spectrum. K | n makes FFTW's default blocks exactly n/K.
   const ptrdiff_t cdims[3] = {n, n, nzh};
   ptrdiff_t ln0 = 0, l0s = 0, ln1 = 0, l1s = 0;
-  ptrdiff_t alloc = fftw_mpi_local_size_many_transposed(
-      3, cdims, 3, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK, MPI_COMM_WORLD, &ln0, &l0s,
-      &ln1, &l1s);
+  ptrdiff_t alloc = fftw_mpi_local_size_many_transposed(3, cdims, 3, FFTW_MPI_DEFAULT_BLOCK,
+                                                        FFTW_MPI_DEFAULT_BLOCK, MPI_COMM_WORLD,
+                                                        &ln0, &l0s, &ln1, &l1s);
   if (ln0 != n / ranks_ || l0s != ptrdiff_t(rank_) * (n / ranks_) || ln1 != n / ranks_ ||
       l1s != ptrdiff_t(rank_) * (n / ranks_))
     throw std::runtime_error("DistributedFluid: unexpected FFTW MPI distribution");
@@ -116,12 +116,12 @@ DistributedFluid::DistributedFluid(const GridSpec& grid, const FluidParams& para
     fftw_mpi_broadcast_wisdom(MPI_COMM_WORLD);
   }
   fftw_plan_with_nthreads(threads_);
-  plan_forward_ = fftw_mpi_plan_many_dft_r2c(3, rdims, 3, FFTW_MPI_DEFAULT_BLOCK,
-                                             FFTW_MPI_DEFAULT_BLOCK, buf_, spec, MPI_COMM_WORLD,
-                                             flags | FFTW_MPI_TRANSPOSED_OUT);
-  plan_backward_ = fftw_mpi_plan_many_dft_c2r(3, rdims, 3, FFTW_MPI_DEFAULT_BLOCK,
-                                              FFTW_MPI_DEFAULT_BLOCK, spec, buf_, MPI_COMM_WORLD,
-                                              flags | FFTW_MPI_TRANSPOSED_IN);
+  plan_forward_ =
+      fftw_mpi_plan_many_dft_r2c(3, rdims, 3, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK, buf_,
+                                 spec, MPI_COMM_WORLD, flags | FFTW_MPI_TRANSPOSED_OUT);
+  plan_backward_ =
+      fftw_mpi_plan_many_dft_c2r(3, rdims, 3, FFTW_MPI_DEFAULT_BLOCK, FFTW_MPI_DEFAULT_BLOCK, spec,
+                                 buf_, MPI_COMM_WORLD, flags | FFTW_MPI_TRANSPOSED_IN);
   int ok = plan_forward_ && plan_backward_ ? 1 : 0, all_ok = 0;
   MPI_Allreduce(&ok, &all_ok, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
   if (!all_ok) {
@@ -188,8 +188,7 @@ void DistributedFluid::begin_step() {
 #pragma omp parallel for num_threads(threads_) schedule(static)
   for (int i = 0; i < nx_; ++i) {
     std::array<double*, 3> r{f_[0] + i * pl, f_[1] + i * pl, f_[2] + i * pl};
-    detail::rhs_plane(n, h, next_.data(), prev_.data(), at(i + 1), at(i + 2), at(i), r, a, b,
-                      true);
+    detail::rhs_plane(n, h, next_.data(), prev_.data(), at(i + 1), at(i + 2), at(i), r, a, b, true);
   }
 }
 
@@ -337,8 +336,7 @@ void DistributedFluid::gather_velocity(std::vector<double>& full) const {
 
 void DistributedFluid::scatter_velocity(std::array<const double*, 3> full) {
   const std::size_t own = std::size_t(nx_) * plane_;
-  for (int c = 0; c < 3; ++c)
-    std::copy_n(full[c] + std::size_t(x0_) * plane_, own, velocity(c));
+  for (int c = 0; c < 3; ++c) std::copy_n(full[c] + std::size_t(x0_) * plane_, own, velocity(c));
   exchange_halos();
 }
 

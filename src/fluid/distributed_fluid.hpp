@@ -104,7 +104,7 @@ class DistributedFluid {
   void* plan_backward_ = nullptr;  // fftw_plan
   std::vector<int> next_, prev_;
   std::vector<double> grad_symbol_, lap_symbol_;  // as FluidSolver's
-  std::vector<double> gathered_;   // sum_over_ranks scratch
+  std::vector<double> gathered_;                  // sum_over_ranks scratch
   void release();
   void spectral_pass();
 };

@@ -56,7 +56,7 @@ FluidSolver::FluidSolver(const GridSpec& grid, const FluidParams& params, int th
   plane_c_ = std::size_t(n) * nzh;
   while (plane_c_ % 8 != 4) plane_c_ += 2;  // 16-byte values: 4 mod 8 = an odd number of lines
   const std::size_t nc = std::size_t(n) * plane_c_;  // component stride, complex values
-  const std::size_t np = std::size_t(n) * n;  // points of one real x-plane
+  const std::size_t np = std::size_t(n) * n;         // points of one real x-plane
   plan_measure_ = plan_measure;
   // The three components of u and f (and of the plane buffer) lie apart by their size plus
   // kCompPad doubles: unpadded, they are a multiple of 4 KiB apart, and the rows that the
@@ -88,15 +88,14 @@ FluidSolver::FluidSolver(const GridSpec& grid, const FluidParams& params, int th
   // complex values, which alternate between two alignments when n/2+1 is odd: one x plan each.
   // FFTW_DESTROY_INPUT: the plane buffer and r̂ are scratch.
   const int plane_dims[2] = {n, n};
-  fftw_iodim xdim{n, int(plane_c_), int(plane_c_)};  // the x axis of the half spectrum
+  fftw_iodim xdim{n, int(plane_c_), int(plane_c_)};           // the x axis of the half spectrum
   fftw_iodim many[2] = {{nzh, 1, 1}, {3, int(nc), int(nc)}};  // k_z, then the component
   auto make_plans = [&](unsigned fl) {
     fftw_plan_with_nthreads(1);
-    plan_plane_r2c_ = fftw_plan_many_dft_r2c(2, plane_dims, 3, plane_buf_, nullptr, 1,
-                                             int(comp_p_),
+    plan_plane_r2c_ = fftw_plan_many_dft_r2c(2, plane_dims, 3, plane_buf_, nullptr, 1, int(comp_p_),
                                              fh, nullptr, 1, int(nc), fl);
-    plan_plane_c2r_ = fftw_plan_many_dft_c2r(2, plane_dims, 3, fh, nullptr, 1, int(nc), u,
-                                             nullptr, 1, int(comp_r_), fl);
+    plan_plane_c2r_ = fftw_plan_many_dft_c2r(2, plane_dims, 3, fh, nullptr, 1, int(nc), u, nullptr,
+                                             1, int(comp_r_), fl);
     bool ok = plan_plane_r2c_ && plan_plane_c2r_;
     for (int par = 0; par < 2; ++par) {
       fftw_complex* slice = fh + par * nzh;
@@ -122,9 +121,9 @@ FluidSolver::FluidSolver(const GridSpec& grid, const FluidParams& params, int th
 FluidSolver::~FluidSolver() { release(); }
 
 void FluidSolver::release_plans() {
-  for (void** p : {&plan_plane_r2c_, &plan_plane_c2r_, &plan_x_fwd_[0], &plan_x_fwd_[1],
-                   &plan_x_bwd_[0], &plan_x_bwd_[1], &plan_forward_, &plan_backward_,
-                   &plan_split_r2c_}) {
+  for (void** p :
+       {&plan_plane_r2c_, &plan_plane_c2r_, &plan_x_fwd_[0], &plan_x_fwd_[1], &plan_x_bwd_[0],
+        &plan_x_bwd_[1], &plan_forward_, &plan_backward_, &plan_split_r2c_}) {
     if (*p) fftw_destroy_plan(as_plan(*p));
     *p = nullptr;
   }
@@ -172,7 +171,7 @@ void FluidSolver::pass_rhs_planes(const PlaneForcing* forcing) {
   const int n = grid_.n;
   const std::size_t np = std::size_t(n) * n;
   const double h = grid_.h();
-  const double a = params_.density / params_.dt;             // ρ/Δt
+  const double a = params_.density / params_.dt;               // ρ/Δt
   const double b = params_.advection ? params_.density : 0.0;  // ρ, or 0 for Stokes
   const int* next = next_.data();
   const int* prev = prev_.data();
@@ -241,8 +240,8 @@ void FluidSolver::run_split_ffts_only() {
     const int dims[2] = {n, n};
     auto make = [&](unsigned fl) {
       fftw_plan_with_nthreads(1);
-      plan_split_r2c_ = fftw_plan_many_dft_r2c(2, dims, 3, f_[0], nullptr, 1, int(comp_r_),
-                                               fh, nullptr, 1, int(n * plane_c_), fl);
+      plan_split_r2c_ = fftw_plan_many_dft_r2c(2, dims, 3, f_[0], nullptr, 1, int(comp_r_), fh,
+                                               nullptr, 1, int(n * plane_c_), fl);
       return plan_split_r2c_ != nullptr;
     };
     if (!plan_with_wisdom(plan_measure_, FFTW_DESTROY_INPUT, make))
@@ -280,11 +279,11 @@ IBROD_TARGET_CLONES void solve_row(int len, double gx, double gy, double gxy2, d
 #pragma omp simd
   for (int t = 0; t < len; ++t) {
     const double gz = gz2[t];
-    const double g2 = gxy2 + gz * gz + DBL_MIN;                     // |ĝ|² + ε, Å⁻²
-    const double den = 1.0 + visc_per_inertia * (lxy + lz2[t]);     // den'
+    const double g2 = gxy2 + gz * gz + DBL_MIN;                  // |ĝ|² + ε, Å⁻²
+    const double den = 1.0 + visc_per_inertia * (lxy + lz2[t]);  // den'
     const double q = 1.0 / (g2 * den);
-    const double ig2 = den * q;                    // 1/|ĝ|²
-    const double scale = out_scale * (g2 * q);     // norm/(ρ/Δt)/den'
+    const double ig2 = den * q;                 // 1/|ĝ|²
+    const double scale = out_scale * (g2 * q);  // norm/(ρ/Δt)/den'
     const double a0 = r0[t], a1 = r1[t], a2 = r2[t];
     const double p = (gx * a0 + gy * a1 + gz * a2) * ig2;  // ĝ·r̂ / |ĝ|²
     r0[t] = scale * (a0 - gx * p);
@@ -297,7 +296,7 @@ IBROD_TARGET_CLONES void solve_row(int len, double gx, double gy, double gxy2, d
 
 void FluidSolver::solve_slice(int j) {
   const int n = grid_.n;
-  const double inertia = params_.density / params_.dt;  // ρ/Δt, g Å⁻³ s⁻¹
+  const double inertia = params_.density / params_.dt;          // ρ/Δt, g Å⁻³ s⁻¹
   const double visc_per_inertia = params_.viscosity / inertia;  // μΔt/ρ, Å²
   // the unnormalised FFTW round trip multiplies by n³
   const double out_scale = 1.0 / double(grid_.size()) / inertia;
@@ -418,11 +417,11 @@ IBROD_TARGET_CLONES void solve_row_stokes(int len, double gx, double gy, double 
   for (int t = 0; t < len; ++t) {
     const double gz = gz2[t];
     constexpr double kEps = 1e-150;
-    const double g2 = gxy2 + gz * gz + kEps;      // |ĝ|² + ε, Å⁻²
-    const double lap = lxy + lz2[t] + kEps;       // −L̂ + ε, Å⁻²
+    const double g2 = gxy2 + gz * gz + kEps;  // |ĝ|² + ε, Å⁻²
+    const double lap = lxy + lz2[t] + kEps;   // −L̂ + ε, Å⁻²
     const double q = 1.0 / (g2 * lap);
-    const double ig2 = lap * q;                   // 1/|ĝ|²
-    const double scale = out_scale * (g2 * q);    // 1/(n³ μ (−L̂))
+    const double ig2 = lap * q;                 // 1/|ĝ|²
+    const double scale = out_scale * (g2 * q);  // 1/(n³ μ (−L̂))
     const double a0 = r0[t], a1 = r1[t], a2 = r2[t];
     const double p = (gx * a0 + gy * a1 + gz * a2) * ig2;
     r0[t] = scale * (a0 - gx * p);

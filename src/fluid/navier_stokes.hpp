@@ -52,8 +52,9 @@ class FluidSolver {
   /// threads: FFTW/OpenMP threads (0 = OpenMP default). plan_measure: FFTW_MEASURE (true) or
   /// FFTW_ESTIMATE (false; fast to plan, for tests). With FFTW_MEASURE, plans already in the
   /// process's wisdom (e.g. a resumed run's own, imported first) are used as they are; otherwise
-  /// the wisdom cache (fluid/fftw_wisdom.hpp: wisdom_cache_path()) is imported, and if it lacks these plans they are
-  /// measured and the cache rewritten. An unreadable or unwritable cache is ignored.
+  /// the wisdom cache (fluid/fftw_wisdom.hpp: wisdom_cache_path()) is imported, and if it lacks
+  /// these plans they are measured and the cache rewritten. An unreadable or unwritable cache is
+  /// ignored.
   FluidSolver(const GridSpec& grid, const FluidParams& params, int threads = 0,
               bool plan_measure = true);
   ~FluidSolver();
@@ -74,8 +75,14 @@ class FluidSolver {
   /// body-force density component c, g Å⁻² s⁻² (force per volume). Callers accumulate (+=) into
   /// it after zero_force() (or begin_step()); step() and finish_step() consume it and leave it
   /// zero. The non-const accessors mark it as written.
-  double* force(int c) { force_zero_ = false; return f_[c]; }
-  std::array<double*, 3> force() { force_zero_ = false; return {f_[0], f_[1], f_[2]}; }
+  double* force(int c) {
+    force_zero_ = false;
+    return f_[c];
+  }
+  std::array<double*, 3> force() {
+    force_zero_ = false;
+    return {f_[0], f_[1], f_[2]};
+  }
   void zero_force();
 
   /// Advance u by one step Δt with the current force density (MODEL §4). No allocation.
@@ -135,28 +142,28 @@ class FluidSolver {
   std::array<std::complex<double>*, 3> fh_{};  // r̂, then ûⁿ⁺¹, layout [x][y][k_z], x-stride
                                                //   plane_c_ ≥ n(n/2+1) (padded, see constructor)
   std::size_t plane_c_ = 0;
-  std::size_t comp_r_ = 0;  // component stride of u_ and f_, doubles (n³ + padding)
-  std::size_t comp_p_ = 0;  // component stride in a thread's plane buffer (n² + padding)
-  double* plane_buf_ = nullptr;                // per thread: 3 real n×n planes of r
-  bool force_zero_ = true;                     // f_ known to be all zero
+  std::size_t comp_r_ = 0;       // component stride of u_ and f_, doubles (n³ + padding)
+  std::size_t comp_p_ = 0;       // component stride in a thread's plane buffer (n² + padding)
+  double* plane_buf_ = nullptr;  // per thread: 3 real n×n planes of r
+  bool force_zero_ = true;       // f_ known to be all zero
   bool plan_measure_ = true;
-  void* plan_plane_r2c_ = nullptr;   // 3 × 2-D (y, z) r2c: plane buffer → r̂ plane
-  void* plan_plane_c2r_ = nullptr;   // 3 × 2-D (y, z) c2r: û plane → u plane
-  void* plan_x_fwd_[2] = {};         // 1-D x FFTs of one y-slice (k_z × 3 components), for the
-  void* plan_x_bwd_[2] = {};         //   two alignments of a slice start (even, odd y)
-  void* plan_forward_ = nullptr;     // benchmark only: threaded 3-D r2c, 3 components
-  void* plan_backward_ = nullptr;    // benchmark only: threaded 3-D c2r, 3 components
-  void* plan_split_r2c_ = nullptr;   // benchmark only: plan_plane_r2c_ reading the force array
+  void* plan_plane_r2c_ = nullptr;  // 3 × 2-D (y, z) r2c: plane buffer → r̂ plane
+  void* plan_plane_c2r_ = nullptr;  // 3 × 2-D (y, z) c2r: û plane → u plane
+  void* plan_x_fwd_[2] = {};        // 1-D x FFTs of one y-slice (k_z × 3 components), for the
+  void* plan_x_bwd_[2] = {};        //   two alignments of a slice start (even, odd y)
+  void* plan_forward_ = nullptr;    // benchmark only: threaded 3-D r2c, 3 components
+  void* plan_backward_ = nullptr;   // benchmark only: threaded 3-D c2r, 3 components
+  void* plan_split_r2c_ = nullptr;  // benchmark only: plan_plane_r2c_ reading the force array
   int threads_ = 1;
   std::vector<int> next_, prev_;     // periodic neighbour index i ± 1 (mod n), made once
   std::vector<double> grad_symbol_;  // sin(2πk/n)/h, Å⁻¹, k = 0..n−1; exactly 0 at k = 0, n/2
-  std::vector<double> lap_symbol_;   // (4/h²) sin²(πk/n), Å⁻², k = 0..n−1 (= −L̂ per direction)
+  std::vector<double> lap_symbol_;  // (4/h²) sin²(πk/n), Å⁻², k = 0..n−1 (= −L̂ per direction)
   std::vector<double> grad_symbol2_, lap_symbol2_;  // k = 0..n/2, each twice (re, im)
-  void release();                    // frees plans and buffers (destructor, failed constructor)
+  void release();  // frees plans and buffers (destructor, failed constructor)
   void release_plans();
-  void solve_slice(int j);           // r̂ → ûⁿ⁺¹ in place on the y-slice j: projection,
-                                     // implicit viscosity, 1/n³
-  void solve_slice_stokes(int j);    // f̂ → û of the Stokes limit in place on the y-slice j
+  void solve_slice(int j);         // r̂ → ûⁿ⁺¹ in place on the y-slice j: projection,
+                                   // implicit viscosity, 1/n³
+  void solve_slice_stokes(int j);  // f̂ → û of the Stokes limit in place on the y-slice j
 };
 
 }  // namespace ibrod::fluid

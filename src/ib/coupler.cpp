@@ -51,8 +51,8 @@ void spread_point(const PointStencil& st, const Vec3& F, const Vec3& T, const Gr
       const double Ay = F[1] * p12 - d1p2 * hTz, By = p12 * hTx;
       const double Az = F[2] * p12 + d1p2 * hTy - p1d2 * hTx;
       const std::size_t row = (std::size_t(xi) * n + std::size_t(st.idx[1][b])) * n;
-      spread_row(f[0] + row + z0, f[1] + row + z0, f[2] + row + z0, st.phi[2], st.dphi[2], len1,
-                 Ax, Ay, Az, Bx, By);
+      spread_row(f[0] + row + z0, f[1] + row + z0, f[2] + row + z0, st.phi[2], st.dphi[2], len1, Ax,
+                 Ay, Az, Bx, By);
       if (len1 < S) {
         spread_row(f[0] + row, f[1] + row, f[2] + row, st.phi[2] + len1, st.dphi[2] + len1,
                    S - len1, Ax, Ay, Az, Bx, By);
@@ -79,8 +79,7 @@ inline void interpolate_row(const double* __restrict ux, const double* __restric
 //   Σ_row u × g = (p₁₂ s₄ − φ₁dφ₂ s₂,  dφ₁φ₂ s₂ − p₁₂ s₃,  φ₁dφ₂ s₀ − dφ₁φ₂ s₁).
 template <bool Slab>
 void interpolate_point(const PointStencil& st, const GridSpec& grid,
-                       const std::array<const double*, 3>& u, Vec3& uw, Vec3& uxg, int x0,
-                       int nx) {
+                       const std::array<const double*, 3>& u, Vec3& uw, Vec3& uxg, int x0, int nx) {
   const int S = st.S;
   const std::size_t n = std::size_t(grid.n);
   const int z0 = st.idx[2][0];
@@ -136,16 +135,15 @@ Coupler::Coupler(const GridSpec& grid, int kernel_width, XSlab slab)
                                 " Å must be positive");
   }
   if (stencil() > grid_.n) {
-    throw std::invalid_argument("ib::Coupler: the stencil of kernel width m = " +
-                                std::to_string(m_) + " spans 4m + 2 = " +
-                                std::to_string(stencil()) + " grid points, more than n = " +
-                                std::to_string(grid_.n));
+    throw std::invalid_argument(
+        "ib::Coupler: the stencil of kernel width m = " + std::to_string(m_) + " spans 4m + 2 = " +
+        std::to_string(stencil()) + " grid points, more than n = " + std::to_string(grid_.n));
   }
   if (slab_.begin < 0 || slab_.begin >= grid_.n || slab_.count < 1 || slab_.count > grid_.n) {
     throw std::invalid_argument("ib::Coupler: x slab [" + std::to_string(slab_.begin) + ", " +
-                                std::to_string(slab_.begin) + " + " +
-                                std::to_string(slab_.count) + ") is not within a grid of n = " +
-                                std::to_string(grid_.n) + " planes");
+                                std::to_string(slab_.begin) + " + " + std::to_string(slab_.count) +
+                                ") is not within a grid of n = " + std::to_string(grid_.n) +
+                                " planes");
   }
   whole_ = slab_.begin == 0 && slab_.count == grid_.n;
   // Slabs at least S wide, so a stencil starting in slab b ends in slab b or b + 1; an even count
@@ -193,8 +191,8 @@ void Coupler::spread(std::span<const Vec3> X, std::span<const Vec3> F, std::span
         } else if (touches_slab(first)) {
           // the same writes as the whole grid's, less those off the slab: race-free alike
           const PointStencil st(X[k], grid_, m_);
-          spread_point<true>(st, F[k], torques ? T[k] : Vec3::Zero().eval(), grid_, f,
-                             slab_.begin, slab_.count);
+          spread_point<true>(st, F[k], torques ? T[k] : Vec3::Zero().eval(), grid_, f, slab_.begin,
+                             slab_.count);
         }
       }
     }

@@ -65,12 +65,12 @@ class Coupler {
 
   /// Accumulates (+=) the force density of point forces F and torques T at X into f
   /// (g Å⁻² s⁻²). T may be empty (no torques). f: three distinct, non-overlapping arrays of
-  /// grid().size() values, layout GridSpec::index (slab(): only its planes, see XSlab). Throws std::invalid_argument if F (or a
-  /// non-empty T) differs in size from X, ibrod::RunError if a position is not finite or absurdly
-  /// far out (|X_d| > 2⁴⁰ h).
-  /// Race-free in parallel: the x axis is cut into an even number of slabs at least 4m + 2 wide,
-  /// so a point's stencil touches only its own slab and the next; even slabs are done in
-  /// parallel, then odd ones. Each grid value thus receives its contributions in a fixed order.
+  /// grid().size() values, layout GridSpec::index (slab(): only its planes, see XSlab). Throws
+  /// std::invalid_argument if F (or a non-empty T) differs in size from X, ibrod::RunError if a
+  /// position is not finite or absurdly far out (|X_d| > 2⁴⁰ h). Race-free in parallel: the x axis
+  /// is cut into an even number of slabs at least 4m + 2 wide, so a point's stencil touches only
+  /// its own slab and the next; even slabs are done in parallel, then odd ones. Each grid value
+  /// thus receives its contributions in a fixed order.
   void spread(std::span<const Vec3> X, std::span<const Vec3> F, std::span<const Vec3> T,
               std::array<double*, 3> f) const;
 
@@ -84,10 +84,10 @@ class Coupler {
  private:
   GridSpec grid_;
   int m_;
-  int nslabs_;                 ///< x slabs for race-free parallel spreading (1 or even)
-  std::vector<int> slab_of_;   ///< [n] slab of each x index
-  XSlab slab_;                 ///< the x-planes of the arrays
-  bool whole_ = true;          ///< slab_ is the whole grid
+  int nslabs_;                ///< x slabs for race-free parallel spreading (1 or even)
+  std::vector<int> slab_of_;  ///< [n] slab of each x index
+  XSlab slab_;                ///< the x-planes of the arrays
+  bool whole_ = true;         ///< slab_ is the whole grid
   /// true if the stencil of a point whose first wrapped x index is `first` meets slab_
   bool touches_slab(int first) const;
 };

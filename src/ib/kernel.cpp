@@ -28,8 +28,7 @@ void check_positions(std::span<const Vec3> X, double h) {
   const double limit = kMaxGridCoordinate * h;
   for (std::size_t k = 0; k < X.size(); ++k) {
     // written so that NaN fails too
-    if (!(std::abs(X[k][0]) <= limit && std::abs(X[k][1]) <= limit &&
-          std::abs(X[k][2]) <= limit)) {
+    if (!(std::abs(X[k][0]) <= limit && std::abs(X[k][1]) <= limit && std::abs(X[k][2]) <= limit)) {
       throw RunError("ib::Coupler: point " + std::to_string(k) +
                      " has a non-finite or out-of-range position (" + std::to_string(X[k][0]) +
                      ", " + std::to_string(X[k][1]) + ", " + std::to_string(X[k][2]) + ") Å");

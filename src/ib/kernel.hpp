@@ -107,8 +107,8 @@ void check_size(const char* what, std::size_t got, std::size_t want);
 // One row of the stencil (fixed x and y index; z runs over a contiguous piece of the grid row):
 // f_d[c] += A_d φ₃[c] + B_d dφ₃[c]. restrict: the three components are separate arrays.
 inline void spread_row(double* __restrict fx, double* __restrict fy, double* __restrict fz,
-                       const double* __restrict p3, const double* __restrict d3, int len,
-                       double Ax, double Ay, double Az, double Bx, double By) {
+                       const double* __restrict p3, const double* __restrict d3, int len, double Ax,
+                       double Ay, double Az, double Bx, double By) {
   for (int c = 0; c < len; ++c) {
     fx[c] += Ax * p3[c] + Bx * d3[c];
     fy[c] += Ay * p3[c] + By * d3[c];

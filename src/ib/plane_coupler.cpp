@@ -151,9 +151,9 @@ using v4d = double __attribute__((vector_size(32)));
 [[gnu::always_inline]] inline void store4(double* p, v4d v) { std::memcpy(p, &v, sizeof v); }
 
 // f_x += A_x φ₃ + B_x dφ₃, f_y += A_y φ₃ + B_y dφ₃, f_z += A_z φ₃ over 8 padded values
-[[gnu::always_inline]] inline void spread_row8(double* fx, double* fy, double* fz,
-                                               const double* p3, const double* d3, double Ax,
-                                               double Ay, double Az, double Bx, double By) {
+[[gnu::always_inline]] inline void spread_row8(double* fx, double* fy, double* fz, const double* p3,
+                                               const double* d3, double Ax, double Ay, double Az,
+                                               double Bx, double By) {
   for (int h = 0; h < 8; h += 4) {
     const v4d P = load4(p3 + h), D = load4(d3 + h);
     store4(fx + h, load4(fx + h) + Ax * P + Bx * D);
@@ -199,8 +199,7 @@ template <int PC>
         spread_row8(fx + z0, fy + z0, fz + z0, p3, d3, Ax, Ay, Az, Bx, By);
       } else {
         spread_row(fx + z0, fy + z0, fz + z0, p3, d3, len1, Ax, Ay, Az, Bx, By);
-        if (len1 < S)
-          spread_row(fx, fy, fz, p3 + len1, d3 + len1, S - len1, Ax, Ay, Az, Bx, By);
+        if (len1 < S) spread_row(fx, fy, fz, p3 + len1, d3 + len1, S - len1, Ax, Ay, Az, Bx, By);
       }
       if (++j == n) j = 0;
     }
@@ -235,9 +234,9 @@ inline void sample_row(ColumnSums& cs, const double* u0, const double* u1, const
 struct ColumnSums8 {
   v4d A0[2] = {}, A1[2] = {}, A2[2] = {}, B[2] = {}, C[2] = {}, D[2] = {};
 };
-[[gnu::always_inline]] inline void sample_row8(ColumnSums8& cs, const double* u0,
-                                               const double* u1, const double* u2, double p12,
-                                               double d1p2, double p1d2) {
+[[gnu::always_inline]] inline void sample_row8(ColumnSums8& cs, const double* u0, const double* u1,
+                                               const double* u2, double p12, double d1p2,
+                                               double p1d2) {
   for (int h = 0; h < 2; ++h) {
     const v4d x = load4(u0 + 4 * h), y = load4(u1 + 4 * h), z = load4(u2 + 4 * h);
     cs.A0[h] += p12 * x;
@@ -319,8 +318,8 @@ template <int PC>
 
 #pragma GCC diagnostic pop
 
-IBROD_TARGET_CLONES void spread_plane_entries(const PlaneEntries& v, const Vec3* F,
-                                              const Vec3* T, std::array<double*, 3> plane) {
+IBROD_TARGET_CLONES void spread_plane_entries(const PlaneEntries& v, const Vec3* F, const Vec3* T,
+                                              std::array<double*, 3> plane) {
   if (v.P == 8)
     spread_entries<8>(v, F, T, plane);
   else
@@ -328,8 +327,7 @@ IBROD_TARGET_CLONES void spread_plane_entries(const PlaneEntries& v, const Vec3*
 }
 
 IBROD_TARGET_CLONES void sample_plane_entries(const PlaneEntries& v,
-                                              std::array<const double*, 3> plane,
-                                              double* share) {
+                                              std::array<const double*, 3> plane, double* share) {
   if (v.P == 8)
     sample_entries<8>(v, plane, share);
   else
@@ -340,14 +338,28 @@ IBROD_TARGET_CLONES void sample_plane_entries(const PlaneEntries& v,
 
 void PlaneCoupler::add_plane(int i, std::array<double*, 3> plane) const {
   if (F_.empty()) return;
-  const PlaneEntries v{grid_.n, S_, P_, entries_.data(), plane_start_[std::size_t(i)],
-                       plane_start_[std::size_t(i) + 1], first_.data(), phi_.data(), dphi_.data()};
+  const PlaneEntries v{grid_.n,
+                       S_,
+                       P_,
+                       entries_.data(),
+                       plane_start_[std::size_t(i)],
+                       plane_start_[std::size_t(i) + 1],
+                       first_.data(),
+                       phi_.data(),
+                       dphi_.data()};
   spread_plane_entries(v, F_.data(), T_.empty() ? nullptr : T_.data(), plane);
 }
 
 void PlaneCoupler::sample_plane(int i, std::array<const double*, 3> plane) {
-  const PlaneEntries v{grid_.n, S_, P_, entries_.data(), plane_start_[std::size_t(i)],
-                       plane_start_[std::size_t(i) + 1], first_.data(), phi_.data(), dphi_.data()};
+  const PlaneEntries v{grid_.n,
+                       S_,
+                       P_,
+                       entries_.data(),
+                       plane_start_[std::size_t(i)],
+                       plane_start_[std::size_t(i) + 1],
+                       first_.data(),
+                       phi_.data(),
+                       dphi_.data()};
   sample_plane_entries(v, plane, share_.data());
 }
 

@@ -53,10 +53,10 @@ class PlaneCoupler {
   std::span<const Vec3> F_, T_;
   std::vector<int> first_;          ///< [k][3] first (wrapped) stencil index per dimension
   std::vector<double> phi_, dphi_;  ///< [k][3][P] φ_d (Å⁻¹), dφ_d (Å⁻²) of point k, 0-padded
-  std::vector<int> plane_start_;    ///< [n + 2] CSR offsets into entries_ per x-plane
-  std::vector<int> entries_;        ///< [2 per entry] (point k, x-stencil entry a), k ascending
-  std::vector<int> entry_of_;       ///< [k][a] the entry of point k's x-stencil entry a
-  std::vector<double> share_;       ///< [entry][6] Σ u w and Σ u × g over that entry's plane
+  std::vector<int> plane_start_;  ///< [n + 2] CSR offsets into entries_ per x-plane
+  std::vector<int> entries_;      ///< [2 per entry] (point k, x-stencil entry a), k ascending
+  std::vector<int> entry_of_;     ///< [k][a] the entry of point k's x-stencil entry a
+  std::vector<double> share_;     ///< [entry][6] Σ u w and Σ u × g over that entry's plane
 };
 
 }  // namespace ibrod::ib

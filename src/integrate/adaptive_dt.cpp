@@ -32,8 +32,8 @@ bool AdaptiveDt::judge(const StepOutcome& o) {
   const double disp_ratio = o.max_displacement / p_.max_displacement;
   const double rot_ratio = o.max_rotation / p_.max_rotation;
   const double ratio = std::max(disp_ratio, rot_ratio);
-  const bool bad = !o.finite || !o.converged || !(ratio <= 1.0) ||
-                   !(o.energy_change <= p_.energy_tolerance);
+  const bool bad =
+      !o.finite || !o.converged || !(ratio <= 1.0) || !(o.energy_change <= p_.energy_tolerance);
   if (bad && !(at_floor && o.finite)) {
     // shrink by `shrink`, or further if the displacement asks for it (it scales with Δt)
     double f = p_.shrink;

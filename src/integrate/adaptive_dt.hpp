@@ -15,13 +15,13 @@
 namespace ibrod::integrate {
 
 struct AdaptiveDtParams {
-  double dt_max = 1e-9;            ///< largest step (and the first), s
-  double dt_min = 1e-12;           ///< a step below this is accepted regardless (see judge())
-  double max_displacement = 1.0;   ///< largest |δX_k| per step, Å
-  double max_rotation = 0.2;       ///< largest |δθ_k| per step, rad
-  double energy_tolerance = 0.0;   ///< allowed rise of the potential energy per step
-  double shrink = 0.5;             ///< Δt factor on rejection
-  double grow = 1.25;              ///< Δt factor after grow_after accepted steps
+  double dt_max = 1e-9;           ///< largest step (and the first), s
+  double dt_min = 1e-12;          ///< a step below this is accepted regardless (see judge())
+  double max_displacement = 1.0;  ///< largest |δX_k| per step, Å
+  double max_rotation = 0.2;      ///< largest |δθ_k| per step, rad
+  double energy_tolerance = 0.0;  ///< allowed rise of the potential energy per step
+  double shrink = 0.5;            ///< Δt factor on rejection
+  double grow = 1.25;             ///< Δt factor after grow_after accepted steps
   int grow_after = 4;
 };
 
@@ -41,7 +41,7 @@ class AdaptiveDt {
   /// Restores a controller's state (resume): its current dt and accepted-in-a-row count.
   AdaptiveDt(const AdaptiveDtParams& p, double dt, int accepted_in_a_row);
 
-  double dt() const { return dt_; }              ///< the step to try next, s
+  double dt() const { return dt_; }  ///< the step to try next, s
   int accepted_in_a_row() const { return run_; }
   long rejections() const { return rejections_; }
   const AdaptiveDtParams& params() const { return p_; }

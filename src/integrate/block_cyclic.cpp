@@ -22,9 +22,7 @@ bool BlockCyclicCholesky::factorize(const std::vector<Mat6>& diag, const std::ve
     L_[k] = llt.matrixL();
     const auto Lk = L_[k].triangularView<Eigen::Lower>();
     // X L_kᵀ = B  ⇔  L_k Xᵀ = Bᵀ
-    auto right_solve = [&](const Mat6& B) -> Mat6 {
-      return Lk.solve(B.transpose()).transpose();
-    };
+    auto right_solve = [&](const Mat6& B) -> Mat6 { return Lk.solve(B.transpose()).transpose(); };
     if (k + 1 <= n - 2) sub_[k] = right_solve(lower[k]);
     // last block row: (S[n−1][k] − L[n−1][k−1] L[k][k−1]ᵀ) L_k⁻ᵀ; S[n−1][k] is the corner
     // S[n−1][0] = lower[n−1]ᵀ for k = 0, the band's lower[n−2] for k = n−2, else 0

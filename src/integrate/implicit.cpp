@@ -250,11 +250,15 @@ Eigen::SparseMatrix<double> ImplicitStepper::stiffness(const rod::RodState& s) {
         const double e = side == 0 ? eps : -eps;
         for (int j = 0; j < n; ++j) {
           if (col[j] != c) continue;
-          if (d < 3) pert_.X[j][d] = s.X[j][d] + e;
-          else pert_.D[j] = rotation(e * Vec3::Unit(d - 3)) * s.D[j];
+          if (d < 3)
+            pert_.X[j][d] = s.X[j][d] + e;
+          else
+            pert_.D[j] = rotation(e * Vec3::Unit(d - 3)) * s.D[j];
         }
-        if (side == 0) forces(Fa_, Ta_, sp, c);
-        else forces(Fb_, Tb_, sm, c);
+        if (side == 0)
+          forces(Fa_, Ta_, sp, c);
+        else
+          forces(Fb_, Tb_, sm, c);
       }
       for (int j = 0; j < n; ++j) {
         if (col[j] != c) continue;
@@ -288,7 +292,8 @@ Eigen::SparseMatrix<double> ImplicitStepper::stiffness(const rod::RodState& s) {
         for (int b = 0; b < 2; ++b) {
           const Mat6 blk = rp.ds * S[a]->transpose() * cinv.asDiagonal() * (*S[b]);
           for (int r = 0; r < 6; ++r)
-            for (int q = 0; q < 6; ++q) trip.emplace_back(6 * idx[a] + r, 6 * idx[b] + q, blk(r, q));
+            for (int q = 0; q < 6; ++q)
+              trip.emplace_back(6 * idx[a] + r, 6 * idx[b] + q, blk(r, q));
         }
     }
   }
@@ -341,9 +346,9 @@ void ImplicitStepper::factorize(double dt) {
     return;
   }
   // velocity form: A = I + Δt M_loc K (row scaling); force form: I + Δt K M_loc (columns)
-  Eigen::SparseMatrix<double> A =
-      p_.velocity_form ? Eigen::SparseMatrix<double>(mloc_.asDiagonal() * K_)
-                       : Eigen::SparseMatrix<double>(K_ * mloc_.asDiagonal());
+  Eigen::SparseMatrix<double> A = p_.velocity_form
+                                      ? Eigen::SparseMatrix<double>(mloc_.asDiagonal() * K_)
+                                      : Eigen::SparseMatrix<double>(K_ * mloc_.asDiagonal());
   A *= dt;
   for (int i = 0; i < 6 * n_; ++i) A.coeffRef(i, i) += 1.0;
   A.makeCompressed();

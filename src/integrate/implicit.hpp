@@ -37,25 +37,25 @@
 namespace ibrod::integrate {
 
 struct ImplicitParams {
-  double mobility_scale = 8.0;   ///< β: M_loc = β × the kernel's self mobility (≥ 0; 0: explicit)
-  int krylov_max_iter = 0;       ///< GMRES iterations after the IMEX guess (0: scheme (1))
-  double krylov_tol = 1e-2;      ///< relative residual of (1) at which GMRES stops
+  double mobility_scale = 8.0;  ///< β: M_loc = β × the kernel's self mobility (≥ 0; 0: explicit)
+  int krylov_max_iter = 0;      ///< GMRES iterations after the IMEX guess (0: scheme (1))
+  double krylov_tol = 1e-2;     ///< relative residual of (1) at which GMRES stops
   /// trial steps between refreshes of K and of its factorisation (≥ 1; K at qⁿ when refreshed,
   /// and whenever Δt changes). 1: K is a function of the state alone, so a run resumed from any
   /// checkpoint (a signal's too) is bitwise the same. > 1 saves ~1.4 ms per step at the 64³
   /// reference (4: 5.3–5.5 against 7.0–7.1 ms, the same accuracy; docs/large_dt.md), and then
   /// only resumes from the periodic checkpoints are bitwise (Simulation::checkpoint_taken).
   int jacobian_every = 1;
-  bool velocity_form = true;     ///< (I + Δt M_loc K) u = M F (true) or (I + Δt K M_loc) g = F
-  bool gauss_newton = true;      ///< K = Δs Σ Jᵀ C J (positive semi-definite) instead of −∂F/∂q
-  bool stiffness_fd = false;     ///< Gauss–Newton K by finite differences (else small-strain
-                                 ///< analytic strain Jacobian, O(n))
+  bool velocity_form = true;  ///< (I + Δt M_loc K) u = M F (true) or (I + Δt K M_loc) g = F
+  bool gauss_newton = true;  ///< K = Δs Σ Jᵀ C J (positive semi-definite) instead of −∂F/∂q
+  bool stiffness_fd = false;  ///< Gauss–Newton K by finite differences (else small-strain
+                              ///< analytic strain Jacobian, O(n))
   /// without contacts, solve the local system with BlockCyclicCholesky (else the general sparse
   /// Cholesky; the same solution to round-off)
   bool block_solver = true;
-  bool steric_implicit = true;   ///< add the steric contacts' stiffness to K
-  double fd_dx = 1e-4;           ///< finite-difference step of K in positions, Å
-  double fd_dtheta = 1e-5;       ///< ... and in rotation vectors, rad
+  bool steric_implicit = true;  ///< add the steric contacts' stiffness to K
+  double fd_dx = 1e-4;          ///< finite-difference step of K in positions, Å
+  double fd_dtheta = 1e-5;      ///< ... and in rotation vectors, rad
 };
 
 /// What one implicit step did (for the adaptive controller and the logs).
@@ -117,28 +117,30 @@ class ImplicitStepper {
   const std::vector<Vec3>& angular_velocities() const { return W_; }  ///< [n] δθ/Δt, s⁻¹
   Stepper& base() { return st_; }
   int contacts() const { return contacts_; }
-  const ImplicitTimings& timings() const { return timings_; }  ///< steric segment contacts in the latest K
+  const ImplicitTimings& timings() const {
+    return timings_;
+  }  ///< steric segment contacts in the latest K
 
  private:
   Stepper& st_;
   ImplicitParams p_;
   int n_;
-  double m_t_ = 0, m_r_ = 0;   // self mobilities
-  double scale_t_ = 1;         // GMRES weight of torques: 1/ℓ, ℓ = √(m_t/m_r)
+  double m_t_ = 0, m_r_ = 0;  // self mobilities
+  double scale_t_ = 1;        // GMRES weight of torques: 1/ℓ, ℓ = √(m_t/m_r)
   Eigen::SparseMatrix<double> K_;
-  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu_;             // full K (not symmetric)
-  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> llt_;        // Gauss–Newton K
-  Eigen::VectorXd mloc_;                                         // diagonal of M_loc
-  std::vector<Eigen::Matrix<double, 6, 6>> Kd_, Ko_;  // GN K blocks: K[k][k], K[k+1][k]
-  BlockCyclicCholesky bcc_;                          // their local system, no contacts
+  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu_;          // full K (not symmetric)
+  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> llt_;    // Gauss–Newton K
+  Eigen::VectorXd mloc_;                                     // diagonal of M_loc
+  std::vector<Eigen::Matrix<double, 6, 6>> Kd_, Ko_;         // GN K blocks: K[k][k], K[k+1][k]
+  BlockCyclicCholesky bcc_;                                  // their local system, no contacts
   std::vector<Eigen::Matrix<double, 6, 6>> sdiag_, slower_;  // its blocks (scratch)
   bool use_blocks_ = false, have_K_ = false;
-  void gn_blocks(const rod::RodState& s);            // fills Kd_, Ko_
-  Eigen::VectorXd local_solve(const Eigen::VectorXd& v) const;   // (I + Δt M_loc K)⁻¹ v
+  void gn_blocks(const rod::RodState& s);                       // fills Kd_, Ko_
+  Eigen::VectorXd local_solve(const Eigen::VectorXd& v) const;  // (I + Δt M_loc K)⁻¹ v
   bool pattern_ready_ = false;
   Eigen::Index pattern_nnz_ = 0;
   int contacts_ = 0, pattern_contacts_ = 0;  // steric contacts in K, in the analysed pattern
-  double lu_dt_ = -1;          // dt of the current factorisation (−1: none)
+  double lu_dt_ = -1;                        // dt of the current factorisation (−1: none)
   long steps_since_jacobian_ = 0;
   StepEnergies last_;
   ImplicitTimings timings_;
@@ -175,7 +177,7 @@ StepOutcome outcome(const ImplicitStepInfo& info);
 class ImplicitIntegrator {
  public:
   struct State {
-    double next_dt = 0;          ///< s
+    double next_dt = 0;  ///< s
     int accepted_in_a_row = 0;
   };
   ImplicitIntegrator(Stepper& stepper, const ImplicitParams& p, const AdaptiveDtParams& a);

@@ -54,8 +54,7 @@ Stepper::Stepper(const StepperParams& p)
 Stepper::~Stepper() = default;
 
 const fluid::FluidSolver* Stepper::serial_fluid() const {
-  if (!fluid_)
-    throw std::logic_error("Stepper::fluid(): the fluid is distributed over MPI ranks");
+  if (!fluid_) throw std::logic_error("Stepper::fluid(): the fluid is distributed over MPI ranks");
   return fluid_.get();
 }
 fluid::FluidSolver* Stepper::serial_fluid() {

@@ -38,8 +38,8 @@ struct StepperParams {
   rod::RodParams rod;
   interactions::ElectroParams electro;
   interactions::StericParams steric;
-  int threads = 0;            ///< OpenMP/FFTW threads, 0 = OpenMP default
-  bool plan_measure = true;   ///< FFTW_MEASURE plans (slower start, faster steps)
+  int threads = 0;           ///< OpenMP/FFTW threads, 0 = OpenMP default
+  bool plan_measure = true;  ///< FFTW_MEASURE plans (slower start, faster steps)
   /// the fluid split over the ranks of MPI_COMM_WORLD (MPI initialised; see the file comment)
   bool distributed = false;
 };
@@ -74,8 +74,8 @@ struct PlaneCouplerSampler final : fluid::PlaneSampler {
 struct StepPhaseTimes {
   static constexpr int kCount = 8;
   static constexpr const char* kNames[kCount] = {
-      "rod forces",        "pair forces",  "kernel weights",  "rhs+spread+2D FFT",
-      "x FFTs+solve",      "2D iFFT+interp.", "interp. sums", "update"};
+      "rod forces",   "pair forces",     "kernel weights", "rhs+spread+2D FFT",
+      "x FFTs+solve", "2D iFFT+interp.", "interp. sums",   "update"};
   double ms[kCount] = {};
 };
 

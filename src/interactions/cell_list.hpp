@@ -46,9 +46,10 @@ inline CellGrid make_grid(std::span<const Vec3> pts, double min_edge, int max_ce
     hi = hi.cwiseMax(x);
   }
   if (!finite || !lo.allFinite() || !hi.allFinite())
-    throw RunError("interactions: a rod position became non-finite (NaN/Inf): the simulation blew "
-                   "up, most likely because time.dt_ns is too large for the stretch/shear or steric "
-                   "stiffness");
+    throw RunError(
+        "interactions: a rod position became non-finite (NaN/Inf): the simulation blew "
+        "up, most likely because time.dt_ns is too large for the stretch/shear or steric "
+        "stiffness");
   CellGrid g;
   g.lo = lo;
   const double edge = min_edge * (1.0 + 1e-9);

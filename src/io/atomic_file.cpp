@@ -13,7 +13,8 @@ namespace ibrod::io {
 
 std::string io_error_text(int err) {
   std::string s = std::strerror(err);
-  if (err == ENOSPC || err == EDQUOT || err == EFBIG) s += " (disk full or over a file-size quota?)";
+  if (err == ENOSPC || err == EDQUOT || err == EFBIG)
+    s += " (disk full or over a file-size quota?)";
   if (err == EACCES || err == EPERM || err == EROFS) s += " (no permission to write there?)";
   return s;
 }
@@ -36,8 +37,8 @@ void AtomicFile::write(const void* data, std::size_t bytes) {
     const ssize_t w = ::write(fd_, p, bytes);
     if (w < 0) {
       if (errno == EINTR) continue;
-      throw RunError("output: cannot write " + tmp_.string() + ": " + io_error_text(errno) +
-                     "; " + target_.filename().string() + " was left as it was");
+      throw RunError("output: cannot write " + tmp_.string() + ": " + io_error_text(errno) + "; " +
+                     target_.filename().string() + " was left as it was");
     }
     p += w;
     bytes -= std::size_t(w);

@@ -207,8 +207,8 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
   const std::uint32_t crc = crc32(payload, h.payload_bytes);
   if (crc != h.crc) {
     char msg[160];
-    std::snprintf(msg, sizeof msg, " is corrupt: CRC-32 of the payload is %08x, the header says %08x",
-                  crc, h.crc);
+    std::snprintf(msg, sizeof msg,
+                  " is corrupt: CRC-32 of the payload is %08x, the header says %08x", crc, h.crc);
     throw ConfigError("checkpoint " + name + msg);
   }
 
@@ -216,7 +216,8 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
   PayloadReader r{payload, std::size_t(h.payload_bytes), name};
   Checkpoint ck;
   const auto json_bytes = r.get_value<std::uint64_t>();
-  if (json_bytes > r.left) throw ConfigError("checkpoint " + name + " is inconsistent: bad meta size");
+  if (json_bytes > r.left)
+    throw ConfigError("checkpoint " + name + " is inconsistent: bad meta size");
   std::string json(json_bytes, '\0');
   r.get(json.data(), json.size());
   try {
@@ -233,13 +234,14 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
   for (Mat3& d : ck.rod.D) r.get(d.data(), 9 * sizeof(double));
   const auto gn = r.get_value<std::int64_t>();
   if (gn < 1 || gn > 1 << 14)
-    throw ConfigError("checkpoint " + name + " is inconsistent: bad grid size " + std::to_string(gn));
+    throw ConfigError("checkpoint " + name + " is inconsistent: bad grid size " +
+                      std::to_string(gn));
   ck.grid_n = int(gn);
   const std::size_t values = 3 * std::size_t(gn) * std::size_t(gn) * std::size_t(gn);
   if (values * sizeof(double) != r.left)
     throw ConfigError("checkpoint " + name + " is inconsistent: the fluid block has " +
-                      std::to_string(r.left) + " bytes, a " + std::to_string(gn) +
-                      "³ grid needs " + std::to_string(values * sizeof(double)));
+                      std::to_string(r.left) + " bytes, a " + std::to_string(gn) + "³ grid needs " +
+                      std::to_string(values * sizeof(double)));
   ck.velocity.resize(values);
   r.get(ck.velocity.data(), values * sizeof(double));
   return ck;

@@ -1,8 +1,9 @@
 #pragma once
-// Checkpoints: the full state of a run — fluid velocity, rod X and D, step and simulated time — plus what the run
-// driver needs to continue it exactly as if it had never stopped (the resolved config, the
-// thread count, the initial observables, the self-passage bookkeeping). ibrod has no random
-// state after the initial condition, so nothing else evolves. One binary file, little-endian:
+// Checkpoints: the full state of a run — fluid velocity, rod X and D, step and simulated time —
+// plus what the run driver needs to continue it exactly as if it had never stopped (the resolved
+// config, the thread count, the initial observables, the self-passage bookkeeping). ibrod has no
+// random state after the initial condition, so nothing else evolves. One binary file,
+// little-endian:
 //
 //   header, 32 bytes:  char[8] magic "IBRODCKP" | u32 format version (kCheckpointVersion)
 //                      | u32 byte-order mark 0x01020304 | u64 payload bytes
@@ -31,16 +32,16 @@ inline constexpr std::uint32_t kCheckpointVersion = 1;
 /// Bookkeeping stored as JSON in the payload.
 struct CheckpointMeta {
   std::int64_t step = 0;
-  double time_s = 0;                 ///< simulated time, s (state: never step × Δt; −1 if absent)
-  int threads = 1;                   ///< resolved OpenMP/FFTW threads of the run that wrote it
-  std::string config_toml;           ///< to_toml() of the run's configuration
-  std::string stop_reason = "none";  ///< "none" while running; end_time/equilibrium at the end
-  sim::Observables initial;          ///< the time-series row at step 0
-  bool self_passage_warning = false; ///< |Lk − Lk(0)| exceeded 0.1 at some output step
+  double time_s = 0;        ///< simulated time, s (state: never step × Δt; −1 if absent)
+  int threads = 1;          ///< resolved OpenMP/FFTW threads of the run that wrote it
+  std::string config_toml;  ///< to_toml() of the run's configuration
+  std::string stop_reason = "none";     ///< "none" while running; end_time/equilibrium at the end
+  sim::Observables initial;             ///< the time-series row at step 0
+  bool self_passage_warning = false;    ///< |Lk − Lk(0)| exceeded 0.1 at some output step
   std::int64_t self_passage_step = -1;  ///< the first such step (−1: none)
-  double max_link_drift = 0;         ///< max |Lk − Lk(0)| over the output steps so far
-  double wall_s = 0;                 ///< wall time of every segment of the run up to here, s
-  std::int64_t resumes = 0;          ///< how many times the run was resumed
+  double max_link_drift = 0;            ///< max |Lk − Lk(0)| over the output steps so far
+  double wall_s = 0;                    ///< wall time of every segment of the run up to here, s
+  std::int64_t resumes = 0;             ///< how many times the run was resumed
   /// the stability tests so far (sim/stability.hpp), a JSON array of objects as summary.json
   /// lists them
   std::string stability_tests_json = "[]";

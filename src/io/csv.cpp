@@ -41,8 +41,7 @@ bool CsvTable::has(const std::string& name) const {
 
 std::span<const double> CsvTable::column(const std::string& name) const {
   const auto it = std::find(names.begin(), names.end(), name);
-  if (it == names.end())
-    throw ConfigError("'" + path.string() + "' has no column '" + name + "'");
+  if (it == names.end()) throw ConfigError("'" + path.string() + "' has no column '" + name + "'");
   return columns[std::size_t(it - names.begin())];
 }
 

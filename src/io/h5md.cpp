@@ -30,7 +30,6 @@ const char* observable_unit(const std::string& name) {
   return nullptr;
 }
 
-
 // HDF5 prints its error stack to stderr by default; ibrod reports errors itself (hdf5_error).
 // No atexit clean-up either: HDF5 1.10 crashes at exit closing a file whose flush failed (a full
 // disk); every file ibrod opens is closed by its owner (Hid) anyway.
@@ -199,7 +198,7 @@ std::vector<hsize_t> shape(const Context& cx, hid_t dset) {
 
 // Appends one record (inner-shaped) along the first axis.
 void append_record(const Context& cx, hid_t dset, hid_t memtype, const void* data,
-            const std::vector<hsize_t>& inner, const char* what) {
+                   const std::vector<hsize_t>& inner, const char* what) {
   const hsize_t t = length(cx, dset);
   std::vector<hsize_t> dims{t + 1}, start{t}, count{1};
   for (hsize_t d : inner) {
@@ -242,19 +241,19 @@ struct Series {
 struct H5mdWriter::Impl {
   Context cx;
   Hid file;
-  std::array<Series, 4> rod;          // kElements
-  Series box;                         // box/edges, one record per frame
+  std::array<Series, 4> rod;  // kElements
+  Series box;                 // box/edges, one record per frame
   double box_A = 0;
-  std::vector<Series> observables;    // observable_fields()
-  std::vector<double> buf;            // one frame of one element, [n × 3]
+  std::vector<Series> observables;  // observable_fields()
+  std::vector<double> buf;          // one frame of one element, [n × 3]
   int n = 0;
 
   void flush() {
     if (H5Fflush(file, H5F_SCOPE_LOCAL) < 0) cx.fail("flush");
   }
 
-  static Series make(const Context& cx, hid_t parent, const char* name,
-                     std::vector<hsize_t> inner, const char* unit) {
+  static Series make(const Context& cx, hid_t parent, const char* name, std::vector<hsize_t> inner,
+                     const char* unit) {
     Series s;
     s.group = cx.group(parent, name, true);
     s.inner = inner;
@@ -275,8 +274,8 @@ struct H5mdWriter::Impl {
     s.time = cx.dataset(s.group, "time");
     s.value = cx.dataset(s.group, "value");
     if (read_string_attribute(s.time, "unit") != kTimeUnit)
-      throw RunError("trajectory " + cx.file + ": /" + name +
-                     "/time is not in " + kTimeUnit + " (written by an older ibrod)");
+      throw RunError("trajectory " + cx.file + ": /" + name + "/time is not in " + kTimeUnit +
+                     " (written by an older ibrod)");
     std::vector<hsize_t> want{0};
     want.insert(want.end(), inner.begin(), inner.end());
     std::vector<hsize_t> got = shape(cx, s.value);
@@ -289,7 +288,8 @@ struct H5mdWriter::Impl {
   // Keeps the records with step <= last (steps increase); returns how many remain.
   static hsize_t truncate(const Context& cx, Series& s, std::int64_t last) {
     const std::vector<std::int64_t> steps = read_steps(cx, s.step);
-    const hsize_t usable = std::min({hsize_t(steps.size()), length(cx, s.time), length(cx, s.value)});
+    const hsize_t usable =
+        std::min({hsize_t(steps.size()), length(cx, s.time), length(cx, s.value)});
     hsize_t keep = 0;
     while (keep < usable && steps[keep] <= last && (keep == 0 || steps[keep] > steps[keep - 1]))
       ++keep;
@@ -351,8 +351,8 @@ std::unique_ptr<H5mdWriter> H5mdWriter::create(const std::filesystem::path& path
   // make a file of a few frames weigh ~300 kB.
   Hid fcpl(H5Pcreate(H5P_FILE_CREATE), H5Pclose);
   H5Pset_istore_k(fcpl, 4);
-  m.file = Hid(cx.ok(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, fcpl, fapl), "create the file"),
-               H5Fclose);
+  m.file =
+      Hid(cx.ok(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, fcpl, fapl), "create the file"), H5Fclose);
 
   {
     Hid h5md = cx.group(m.file, "h5md", true);
@@ -375,7 +375,8 @@ std::unique_ptr<H5mdWriter> H5mdWriter::create(const std::filesystem::path& path
     m.box = Impl::make(cx, box, "edges", {3}, kLengthUnit);
     m.box_A = box_A;
     for (int e2 = 0; e2 < 4; ++e2)
-      m.rod[e2] = Impl::make(cx, rod, kElements[e2], {hsize_t(n), 3}, e2 == 0 ? kLengthUnit : nullptr);
+      m.rod[e2] =
+          Impl::make(cx, rod, kElements[e2], {hsize_t(n), 3}, e2 == 0 ? kLengthUnit : nullptr);
   }
   {
     Hid obs = cx.group(m.file, "observables", true);
@@ -472,7 +473,8 @@ H5mdSeries read_h5md_series(const std::filesystem::path& path, const std::string
   else if (unit != "µs")
     throw RunError("trajectory " + cx.file + ": time unit '" + unit + "' (expected ns or µs)");
   const std::vector<hsize_t> dims = shape(cx, value);
-  if (dims.size() != 3 || dims[2] != 3) throw RunError("trajectory " + cx.file + ": bad value shape");
+  if (dims.size() != 3 || dims[2] != 3)
+    throw RunError("trajectory " + cx.file + ": bad value shape");
   s.n = int(dims[1]);
   s.value.resize(dims[0] * dims[1] * dims[2]);
   if (!s.value.empty() &&

@@ -32,14 +32,13 @@ namespace ibrod::io {
 class H5mdWriter {
  public:
   /// Creates `path` (replacing any file there) with the layout above and no frames.
-  static std::unique_ptr<H5mdWriter> create(const std::filesystem::path& path, int n,
-                                            double box_A, const std::string& config_toml);
+  static std::unique_ptr<H5mdWriter> create(const std::filesystem::path& path, int n, double box_A,
+                                            const std::string& config_toml);
   /// Opens an existing file to continue a run: every frame and row with step > last_step is
   /// dropped, and /parameters/config_toml is set to config_toml. Throws RunError if the file
   /// cannot be opened or does not have the layout for n points.
-  static std::unique_ptr<H5mdWriter> reopen(const std::filesystem::path& path, int n,
-                                            double box_A, std::int64_t last_step,
-                                            const std::string& config_toml);
+  static std::unique_ptr<H5mdWriter> reopen(const std::filesystem::path& path, int n, double box_A,
+                                            std::int64_t last_step, const std::string& config_toml);
   ~H5mdWriter();
   H5mdWriter(const H5mdWriter&) = delete;
   H5mdWriter& operator=(const H5mdWriter&) = delete;

@@ -19,8 +19,8 @@ static_assert(std::endian::native == std::endian::little, "the .npy header says 
 // with spaces and ended by '\n' so that the data starts at a multiple of 64 bytes.
 std::string npy_header(int n) {
   const std::string dims = std::to_string(n);
-  std::string dict = "{'descr': '<f8', 'fortran_order': False, 'shape': (3, " + dims + ", " +
-                     dims + ", " + dims + "), }";
+  std::string dict = "{'descr': '<f8', 'fortran_order': False, 'shape': (3, " + dims + ", " + dims +
+                     ", " + dims + "), }";
   const std::size_t preamble = 10;
   std::size_t total = preamble + dict.size() + 1;
   total = (total + 63) / 64 * 64;

@@ -9,7 +9,6 @@
 #include <filesystem>
 #include <vector>
 
-
 namespace ibrod::io {
 
 /// velocity.npy from three arrays of n³ values each in Å/s (layout GridSpec::index).

@@ -10,9 +10,9 @@ namespace ibrod::io {
 
 /// One time-series column other than step and time_us.
 struct ObservableField {
-  const char* name;                 ///< column name with its unit (E_bend_kT, closest_approach_A, …)
+  const char* name;  ///< column name with its unit (E_bend_kT, closest_approach_A, …)
   double sim::Observables::*member;
-  int csv_digits;                   ///< significant digits in timeseries.csv
+  int csv_digits;  ///< significant digits in timeseries.csv
 };
 
 /// Every column after step and time_us, in CSV order.

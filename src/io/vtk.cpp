@@ -62,10 +62,11 @@ std::string rod_vtp(const rod::RodState& s, double ds_A) {
   }
   std::string out;
   out.reserve(std::size_t(n) * 260 + 1024);
-  out += "<?xml version=\"1.0\"?>\n"
-         "<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" "
-         "header_type=\"UInt64\">\n"
-         "  <PolyData>\n";
+  out +=
+      "<?xml version=\"1.0\"?>\n"
+      "<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" "
+      "header_type=\"UInt64\">\n"
+      "  <PolyData>\n";
   out += "    <Piece NumberOfPoints=\"" + std::to_string(n) +
          "\" NumberOfVerts=\"0\" NumberOfLines=\"1\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n";
   out += "      <PointData Scalars=\"twist_density_rad_per_A\" Vectors=\"d3\">\n";
@@ -74,19 +75,18 @@ std::string rod_vtp(const rod::RodState& s, double ds_A) {
     data_array(out, "Float64", triad_names[c], 3, n,
                [&](std::size_t k, int i) { return s.D[k](i, c); });
   }
-  data_array(out, "Float64", "twist_density_rad_per_A", 1, n, [&](std::size_t k, int) {
-    return 0.5 * (omega[k] + omega[k == 0 ? n - 1 : k - 1]);
-  });
-  data_array(out, "Float64", "stretch_strain", 1, n,
-             [&](std::size_t k, int) { return strain[k]; });
+  data_array(out, "Float64", "twist_density_rad_per_A", 1, n,
+             [&](std::size_t k, int) { return 0.5 * (omega[k] + omega[k == 0 ? n - 1 : k - 1]); });
+  data_array(out, "Float64", "stretch_strain", 1, n, [&](std::size_t k, int) { return strain[k]; });
   out += "      </PointData>\n      <Points>\n";
   data_array(out, "Float64", "Points", 3, n, [&](std::size_t k, int i) { return s.X[k][i]; });
   out += "      </Points>\n      <Lines>\n";
   // closed polyline: the first point again at the end
-  data_array(out, "Int64", "connectivity", 1, std::size_t(n) + 1,
-             [&](std::size_t k, int) { return double(k == std::size_t(n) ? 0 : k); }, "%.0f");
-  data_array(out, "Int64", "offsets", 1, 1, [&](std::size_t, int) { return double(n + 1); },
-             "%.0f");
+  data_array(
+      out, "Int64", "connectivity", 1, std::size_t(n) + 1,
+      [&](std::size_t k, int) { return double(k == std::size_t(n) ? 0 : k); }, "%.0f");
+  data_array(
+      out, "Int64", "offsets", 1, 1, [&](std::size_t, int) { return double(n + 1); }, "%.0f");
   out += "      </Lines>\n    </Piece>\n  </PolyData>\n</VTKFile>\n";
   return out;
 }
@@ -116,8 +116,9 @@ std::string fluid_vti(const GridSpec& g, std::array<const double*, 3> u) {
         return u[c][g.index(i, j, k)] * 1e-9;  // Å/s → Å/ns
       },
       "%.8g");
-  out += "      </PointData>\n      <CellData>\n      </CellData>\n    </Piece>\n"
-         "  </ImageData>\n</VTKFile>\n";
+  out +=
+      "      </PointData>\n      <CellData>\n      </CellData>\n    </Piece>\n"
+      "  </ImageData>\n</VTKFile>\n";
   return out;
 }
 
@@ -170,7 +171,8 @@ void PvdSeries::write_pvd() const {
       "  <Collection>\n";
   char buf[256];
   for (const Entry& e : entries_) {
-    std::snprintf(buf, sizeof buf, "    <DataSet timestep=\"%.12g\" group=\"\" part=\"0\" file=\"%s\"/>\n",
+    std::snprintf(buf, sizeof buf,
+                  "    <DataSet timestep=\"%.12g\" group=\"\" part=\"0\" file=\"%s\"/>\n",
                   e.time_us, e.file.c_str());
     out += buf;
   }

@@ -13,7 +13,8 @@ Image::Image(int w, int h, Rgb fill) : width(w), height(h) {
     throw std::invalid_argument("Image: size " + std::to_string(w) + "x" + std::to_string(h) +
                                 " is not positive");
   rgb.resize(3 * std::size_t(w) * std::size_t(h));
-  for (std::size_t i = 0; i < rgb.size(); i += 3) rgb[i] = fill.r, rgb[i + 1] = fill.g, rgb[i + 2] = fill.b;
+  for (std::size_t i = 0; i < rgb.size(); i += 3)
+    rgb[i] = fill.r, rgb[i + 1] = fill.g, rgb[i + 2] = fill.b;
 }
 
 void write_png(const std::string& path, const Image& image) {

@@ -42,7 +42,9 @@ std::uint8_t to_byte(double v) { return std::uint8_t(std::clamp(std::lround(v), 
 
 }  // namespace
 
-std::vector<std::string> standard_view_names() { return {"top", "bottom", "side", "front", "oblique"}; }
+std::vector<std::string> standard_view_names() {
+  return {"top", "bottom", "side", "front", "oblique"};
+}
 
 View standard_view(const std::string& name) {
   if (name == "top") return {name, {0, 0, -1}, {0, 1, 0}};
@@ -92,7 +94,8 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
   // light from the upper left, in front of the rod
   const Vec3 light = (-0.45 * r + 0.6 * u - 0.65 * f).normalized();
 
-  std::vector<double> depth(std::size_t(W) * std::size_t(H), std::numeric_limits<double>::infinity());
+  std::vector<double> depth(std::size_t(W) * std::size_t(H),
+                            std::numeric_limits<double>::infinity());
   std::vector<float> shade(depth.size(), 0.0f);
   std::vector<std::uint8_t> on_stripe(depth.size(), 0);
 
@@ -158,7 +161,8 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
           const int nx[4] = {px - d, px + d, px, px}, ny[4] = {py, py, py - d, py + d};
           for (int q = 0; q < 4; ++q) {
             if (nx[q] < 0 || ny[q] < 0 || nx[q] >= W || ny[q] >= H) continue;
-            if (depth[std::size_t(ny[q]) * std::size_t(W) + std::size_t(nx[q])] > depth[idx] + R) edge[idx] = 1;
+            if (depth[std::size_t(ny[q]) * std::size_t(W) + std::size_t(nx[q])] > depth[idx] + R)
+              edge[idx] = 1;
           }
         }
       }

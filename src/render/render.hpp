@@ -3,7 +3,8 @@
 // on the side the director D¹ points to, so that twist shows as a helical stripe. Software
 // ray casting of one capsule (cylinder + spherical caps) per segment X_k → X_{k+1} (X_n = X_0)
 // under an orthographic camera, nearest hit per pixel (a z-buffer), Lambert + ambient shading,
-// dark outlines where one part of the tube passes in front of another, S×S supersampling. Knows points and directors only.
+// dark outlines where one part of the tube passes in front of another, S×S supersampling. Knows
+// points and directors only.
 #include <span>
 #include <string>
 #include <vector>
@@ -30,15 +31,15 @@ std::vector<std::string> standard_view_names();
 
 struct Style {
   Rgb background{255, 255, 255};
-  Rgb tube{60, 105, 200};     ///< body colour (blue: b > r)
-  Rgb stripe{240, 170, 30};   ///< stripe colour (orange: r > b)
-  double stripe_cos = 0.8;    ///< the stripe: unit normal · D¹ (⟂ to the axis) above this
-                              ///< (0.8: a band of ±37° about D¹, a fifth of the circumference)
-  double ambient = 0.3;       ///< shade = ambient + (1 − ambient) max(0, n · light)
+  Rgb tube{60, 105, 200};    ///< body colour (blue: b > r)
+  Rgb stripe{240, 170, 30};  ///< stripe colour (orange: r > b)
+  double stripe_cos = 0.8;   ///< the stripe: unit normal · D¹ (⟂ to the axis) above this
+                             ///< (0.8: a band of ±37° about D¹, a fifth of the circumference)
+  double ambient = 0.3;      ///< shade = ambient + (1 − ambient) max(0, n · light)
   double outline_darken = 0.45;  ///< shade factor of a ≈ 1 pixel outline on the near side of
-                                ///< occlusion boundaries (1: no outlines)
-  int supersample = 3;        ///< S×S rays per pixel, averaged
-  double margin = 0.04;       ///< free border on each side, fraction of the smaller image side
+                                 ///< occlusion boundaries (1: no outlines)
+  int supersample = 3;           ///< S×S rays per pixel, averaged
+  double margin = 0.04;          ///< free border on each side, fraction of the smaller image side
 };
 
 /// Renders the tube of diameter `diameter` (X's length unit) about the closed polygon X with the

@@ -14,9 +14,9 @@ namespace ibrod::rod {
 
 /// rod.perturbation_random = { modes = M, amplitude = A, seed = S }; M = 0 or A = 0: none.
 struct RandomPerturbation {
-  int modes = 0;             ///< M, number of modes m = 1..M
-  double amplitude = 0.0;    ///< A, rad
-  std::uint64_t seed = 0;    ///< S, seed of std::mt19937_64
+  int modes = 0;           ///< M, number of modes m = 1..M
+  double amplitude = 0.0;  ///< A, rad
+  std::uint64_t seed = 0;  ///< S, seed of std::mt19937_64
   bool operator==(const RandomPerturbation&) const = default;
 };
 

@@ -11,11 +11,11 @@
 namespace ibrod::rod {
 
 struct RodParams {
-  int n = 600;                            ///< number of rod points (= base pairs)
-  double ds = 3.4;                        ///< Δs, Å (rise per base pair)
-  Vec3 a{1.3e5, 1.3e5, 1.82e5};           ///< a1, a2 (bending), a3 (twist), g Å³ s⁻²
-  Vec3 b{5e3, 5e3, 5e3};                  ///< b1, b2 (shear), b3 (stretch), g Å s⁻²
-  Vec3 omega0{0.0, 0.0, 0.0};             ///< intrinsic curvatures Ω¹₀, Ω²₀ and twist Ω³₀, Å⁻¹
+  int n = 600;                   ///< number of rod points (= base pairs)
+  double ds = 3.4;               ///< Δs, Å (rise per base pair)
+  Vec3 a{1.3e5, 1.3e5, 1.82e5};  ///< a1, a2 (bending), a3 (twist), g Å³ s⁻²
+  Vec3 b{5e3, 5e3, 5e3};         ///< b1, b2 (shear), b3 (stretch), g Å s⁻²
+  Vec3 omega0{0.0, 0.0, 0.0};  ///< intrinsic curvatures Ω¹₀, Ω²₀ and twist Ω³₀, Å⁻¹
 };
 
 struct RodState {
@@ -39,7 +39,13 @@ struct RodWork {
   std::vector<Vec3> Nh;  ///< [n] internal moment N_{k+½}, lab frame, g Å² s⁻²
   std::vector<Vec3> Xp;  ///< [n] X′_{k+½} = (X_{k+1} − X_k)/Δs
   std::vector<Vec3> Eh;  ///< [n] (bend, twist, stretch) energy of half point k+½, g Å² s⁻²
-  void resize(int n) { Dh.resize(n); Fh.resize(n); Nh.resize(n); Xp.resize(n); Eh.resize(n); }
+  void resize(int n) {
+    Dh.resize(n);
+    Fh.resize(n);
+    Nh.resize(n);
+    Xp.resize(n);
+    Eh.resize(n);
+  }
 };
 
 /// Half-point triad √(D_{k+1} D_kᵀ) D_k (principal square root). Exposed for tests.

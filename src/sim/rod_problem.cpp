@@ -20,16 +20,17 @@ std::string rod_problem(const rod::RodState& s, double ds) {
     const double r = (s.X[k1] - s.X[k]).norm() / ds;
     if (!(r >= 0.5 && r <= 1.5)) {
       std::snprintf(buf, sizeof buf,
-                    "the spacing of points %d and %d is %.4g Δs (allowed: 0.5 to 1.5 Δs)", k, k1, r);
+                    "the spacing of points %d and %d is %.4g Δs (allowed: 0.5 to 1.5 Δs)", k, k1,
+                    r);
       return buf;
     }
   }
   for (int k = 0; k < n; ++k) {
     const double e = (s.D[k].transpose() * s.D[k] - Mat3::Identity()).cwiseAbs().maxCoeff();
     if (!(e <= 1e-3)) {
-      std::snprintf(buf, sizeof buf,
-                    "the triad of point %d is off orthonormal by %.3g (max |DᵀD − I|; allowed 1e-3)",
-                    k, e);
+      std::snprintf(
+          buf, sizeof buf,
+          "the triad of point %d is off orthonormal by %.3g (max |DᵀD − I|; allowed 1e-3)", k, e);
       return buf;
     }
   }

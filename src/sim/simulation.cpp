@@ -10,12 +10,18 @@ namespace ibrod::sim {
 
 std::string to_string(StopReason r) {
   switch (r) {
-    case StopReason::none: return "none";
-    case StopReason::end_time: return "end_time";
-    case StopReason::equilibrium: return "equilibrium";
-    case StopReason::interrupted: return "interrupted";
-    case StopReason::blow_up: return "blow_up";
-    case StopReason::error: return "error";
+    case StopReason::none:
+      return "none";
+    case StopReason::end_time:
+      return "end_time";
+    case StopReason::equilibrium:
+      return "equilibrium";
+    case StopReason::interrupted:
+      return "interrupted";
+    case StopReason::blow_up:
+      return "blow_up";
+    case StopReason::error:
+      return "error";
   }
   return "unknown";
 }
@@ -40,8 +46,9 @@ SimParams checked(SimParams p) {
   if (!(p.dt > 0) || !(p.t_end > 0))
     throw std::invalid_argument("Simulation: dt and t_end must be positive");
   if (p.output.rows <= 0 || p.output.frames < 0 || p.output.checkpoints < 0)
-    throw std::invalid_argument("Simulation: output intervals must be positive (frames, "
-                                "checkpoints: or 0)");
+    throw std::invalid_argument(
+        "Simulation: output intervals must be positive (frames, "
+        "checkpoints: or 0)");
   p.stepper.fluid.dt = p.dt;  // the fluid's Δt is the simulation's
   if (p.scheme == TimeScheme::implicit_step) {
     if (p.stepper.distributed)
@@ -65,9 +72,7 @@ SimParams checked(SimParams p) {
 }  // namespace
 
 Simulation::Simulation(const SimParams& p)
-    : p_(checked(p)),
-      rod_(rod::twisted_circle(p_.stepper.rod, p_.circle)),
-      stepper_(p_.stepper) {
+    : p_(checked(p)), rod_(rod::twisted_circle(p_.stepper.rod, p_.circle)), stepper_(p_.stepper) {
   // MODEL §6: the electrostatic energy is also reported relative to the circle at the same salt.
   // The unperturbed circle (perturbation only rotates triads, so X is the same).
   if (p_.stepper.electro.enabled) electro_circle_ = stepper_.electrostatics().energy(rod_.X);
@@ -105,8 +110,8 @@ Observables Simulation::observe() {
   }
   if (p_.stepper.steric.enabled) o.E_steric_kT = stepper_.steric().energy(rod_.X) / kT;
   o.E_kinetic_kT = stepper_.fluid_kinetic_energy() / kT;  // collective when distributed
-  o.E_total_kT = o.E_bend_kT + o.E_twist_kT + o.E_stretch_kT + o.E_electro_kT + o.E_steric_kT +
-                 o.E_kinetic_kT;
+  o.E_total_kT =
+      o.E_bend_kT + o.E_twist_kT + o.E_stretch_kT + o.E_electro_kT + o.E_steric_kT + o.E_kinetic_kT;
 
   const int n = rod_.size();
   std::vector<Vec3> d1(n);

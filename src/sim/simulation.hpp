@@ -12,8 +12,8 @@
 
 #include "integrate/implicit.hpp"
 #include "integrate/stepper.hpp"
-#include "sim/stability.hpp"
 #include "rod/rod.hpp"
+#include "sim/stability.hpp"
 
 namespace ibrod::sim {
 
@@ -40,13 +40,13 @@ struct SimParams {
   /// dt_min ≤ 0 becomes 1e-3 dt, a max_displacement ≤ 0 becomes 0.2 min(1/κ, D))
   integrate::ImplicitParams implicit;
   integrate::AdaptiveDtParams adaptive;
-  double dt = 1e-10;            ///< time step Δt, s (implicit: the largest and the first)
-  double t_end = 1e-6;          ///< s
-  double stop_kinetic = 0;      ///< stop when E_K < this (g Å² s⁻²) at an output step; 0: never
-  StabilityProbe stability;     ///< tests a state the kinetic-energy rule calls an equilibrium
+  double dt = 1e-10;         ///< time step Δt, s (implicit: the largest and the first)
+  double t_end = 1e-6;       ///< s
+  double stop_kinetic = 0;   ///< stop when E_K < this (g Å² s⁻²) at an output step; 0: never
+  StabilityProbe stability;  ///< tests a state the kinetic-energy rule calls an equilibrium
   OutputSchedule output;
-  double kT = 414.2;            ///< g Å² s⁻²
-  int closest_min_separation = 20;   ///< pairs at least this many points apart (MODEL §6)
+  double kT = 414.2;                ///< g Å² s⁻²
+  int closest_min_separation = 20;  ///< pairs at least this many points apart (MODEL §6)
 };
 
 /// One row of the time series (MODEL §6). Energies in kT, time in µs, lengths in Å.
@@ -83,8 +83,8 @@ class Simulation {
   integrate::Stepper& stepper() { return stepper_; }
   const integrate::Stepper& stepper() const { return stepper_; }
   std::int64_t step_count() const { return step_; }
-  double time() const { return time_; }   ///< simulated time, s
-  double dt() const { return p_.dt; }     ///< time step, s (implicit: the largest)
+  double time() const { return time_; }  ///< simulated time, s
+  double dt() const { return p_.dt; }    ///< time step, s (implicit: the largest)
   /// The Δt the next step will try (explicit: dt(); implicit: the controller's), s.
   double next_dt() const { return implicit_ ? implicit_->state().next_dt : p_.dt; }
   /// The implicit scheme (nullptr for the explicit one).
@@ -150,7 +150,7 @@ class Simulation {
   integrate::Stepper stepper_;
   std::unique_ptr<integrate::ImplicitIntegrator> implicit_;  // time.scheme = "implicit"
   std::int64_t step_ = 0;
-  double time_ = 0;               ///< s
+  double time_ = 0;            ///< s
   double electro_circle_ = 0;  ///< E_electro of the initial circle, g Å² s⁻²
 };
 

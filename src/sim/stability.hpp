@@ -27,18 +27,18 @@ class Simulation;
 
 struct StabilityProbe {
   bool enabled = true;
-  double amplitude = 0.05;   ///< A, rad
-  int modes = 4;             ///< M
-  double time = 0.5e-6;      ///< probe time, s
-  double tolerance = 0;      ///< energy drop that counts, g Å² s⁻²
+  double amplitude = 0.05;  ///< A, rad
+  int modes = 4;            ///< M
+  double time = 0.5e-6;     ///< probe time, s
+  double tolerance = 0;     ///< energy drop that counts, g Å² s⁻²
   std::uint64_t seed = 1;
 };
 
 struct ProbeOutcome {
   bool stable = true;
-  std::int64_t step = 0;         ///< the step the probe started at
-  double time_us = 0;            ///< its time
-  std::int64_t steps = 0;        ///< steps integrated
+  std::int64_t step = 0;   ///< the step the probe started at
+  double time_us = 0;      ///< its time
+  std::int64_t steps = 0;  ///< steps integrated
   double E_before_kT = 0, E_after_kT = 0;
   double writhe_before = 0, writhe_after = 0;
 };

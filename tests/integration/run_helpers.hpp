@@ -74,8 +74,8 @@ inline Child spawn(const std::vector<std::string>& args, const fs::path& log,
 }
 
 struct Exit {
-  int code = -1;    ///< exit status, −1 if killed by a signal
-  int signal = 0;   ///< the signal that killed it, 0 if it exited
+  int code = -1;   ///< exit status, −1 if killed by a signal
+  int signal = 0;  ///< the signal that killed it, 0 if it exited
   std::string output;
 };
 

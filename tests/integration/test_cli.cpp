@@ -37,7 +37,8 @@ Result sh(const std::string& args) {
 }
 
 fs::path fresh_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("ibrod_test_" + name + "_" + std::to_string(::getpid()));
+  const fs::path d =
+      fs::temp_directory_path() / ("ibrod_test_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(d);
   fs::create_directories(d);
   return d;
@@ -150,7 +151,8 @@ TEST(Cli, CheckPrintsDerivedQuantities) {
 TEST(Cli, VersionNamesTheVersionCommitBuildAndMpi) {
   const Result r = sh("--version");
   EXPECT_EQ(r.status, 0) << r.output;
-  EXPECT_TRUE(std::regex_search(r.output, std::regex(R"(^ibrod \d+\.\d+\.\d+ \(git \w+, \w+ build, MPI (yes|no)\))")))
+  EXPECT_TRUE(std::regex_search(
+      r.output, std::regex(R"(^ibrod \d+\.\d+\.\d+ \(git \w+, \w+ build, MPI (yes|no)\))")))
       << r.output;
 }
 
@@ -158,7 +160,8 @@ TEST(Cli, CheckWarnsOfAGridCoarserThanTheHardCoreAndAnUndersizedBox) {
   const Result coarse = sh("check --set grid.n=16");  // h = 725/16 = 45 Å > D = 20 Å
   EXPECT_EQ(coarse.status, 0) << coarse.output;
   EXPECT_THAT(coarse.output, HasSubstr("warning: the grid spacing h = 45.3125 Å"));
-  const Result small_box = sh("check --set solvent.salt_M=0.001");  // 1/κ ≈ 96 Å: 3/κ > 725 − 649 − 20
+  const Result small_box =
+      sh("check --set solvent.salt_M=0.001");  // 1/κ ≈ 96 Å: 3/κ > 725 − 649 − 20
   EXPECT_EQ(small_box.status, 0) << small_box.output;
   EXPECT_THAT(small_box.output, HasSubstr("periodic images"));
   const Result fine = sh("check");  // the reference: no warning

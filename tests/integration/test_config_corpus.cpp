@@ -171,20 +171,42 @@ const std::vector<Case> kHandWritten = {
 
 // Every scalar key with values none of them accepts: huge, non-finite, and of the wrong type.
 std::vector<Case> generated() {
-  const char* numeric[] = {
-      "grid.n", "grid.box_A", "grid.kernel_width", "time.dt_ns", "time.t_end_us",
-      "time.stop_kinetic_kT", "rod.base_pairs", "rod.excess_link", "rod.rise_A",
-      "rod.bend_modulus_erg_cm", "rod.twist_modulus_erg_cm", "rod.shear_modulus_dyn",
-      "rod.stretch_modulus_dyn", "rod.intrinsic_twist_per_A", "solvent.salt_M",
-      "solvent.viscosity_poise", "solvent.density_g_cm3", "solvent.temperature_K",
-      "electrostatics.charge_e", "electrostatics.dielectric", "electrostatics.cutoff_debye",
-      "steric.diameter_A", "steric.stiffness", "output.every_steps", "output.frame_every_steps",
-      "output.checkpoint_every_steps", "run.threads", "time.max_displacement_A",
-      "time.energy_tolerance_kT", "time.dt_min_ns", "time.implicit_mobility_scale",
-      "time.implicit_jacobian_every", "time.implicit_krylov_iterations",
-      "time.implicit_krylov_tol"};
+  const char* numeric[] = {"grid.n",
+                           "grid.box_A",
+                           "grid.kernel_width",
+                           "time.dt_ns",
+                           "time.t_end_us",
+                           "time.stop_kinetic_kT",
+                           "rod.base_pairs",
+                           "rod.excess_link",
+                           "rod.rise_A",
+                           "rod.bend_modulus_erg_cm",
+                           "rod.twist_modulus_erg_cm",
+                           "rod.shear_modulus_dyn",
+                           "rod.stretch_modulus_dyn",
+                           "rod.intrinsic_twist_per_A",
+                           "solvent.salt_M",
+                           "solvent.viscosity_poise",
+                           "solvent.density_g_cm3",
+                           "solvent.temperature_K",
+                           "electrostatics.charge_e",
+                           "electrostatics.dielectric",
+                           "electrostatics.cutoff_debye",
+                           "steric.diameter_A",
+                           "steric.stiffness",
+                           "output.every_steps",
+                           "output.frame_every_steps",
+                           "output.checkpoint_every_steps",
+                           "run.threads",
+                           "time.max_displacement_A",
+                           "time.energy_tolerance_kT",
+                           "time.dt_min_ns",
+                           "time.implicit_mobility_scale",
+                           "time.implicit_jacobian_every",
+                           "time.implicit_krylov_iterations",
+                           "time.implicit_krylov_tol"};
   const char* boolean[] = {"solvent.advection", "electrostatics.enabled", "steric.enabled",
-                           "output.fluid_vti", "output.fluid_velocity", "run.fftw_measure"};
+                           "output.fluid_vti",  "output.fluid_velocity",  "run.fftw_measure"};
   std::vector<Case> out;
   auto add = [&](const std::string& key, const std::string& value) {
     const auto dot = key.find('.');
@@ -206,11 +228,11 @@ struct Tally {
   int tried = 0, clean = 0, unnamed = 0, crashes = 0, hangs = 0, accepted = 0;
   void add(Outcome o) {
     ++tried;
-    (o == Outcome::clean      ? clean
-     : o == Outcome::unnamed  ? unnamed
-     : o == Outcome::crash    ? crashes
-     : o == Outcome::hang     ? hangs
-                              : accepted)++;
+    (o == Outcome::clean     ? clean
+     : o == Outcome::unnamed ? unnamed
+     : o == Outcome::crash   ? crashes
+     : o == Outcome::hang    ? hangs
+                             : accepted)++;
   }
 };
 
@@ -236,7 +258,8 @@ Outcome classify(const std::vector<std::string>& args, const std::string& names,
   else
     o = Outcome::unnamed;
   EXPECT_EQ(o, Outcome::clean) << what << "\nexit " << e.code << " signal " << e.signal
-                               << (e.hung ? " (hung)" : "") << "\n" << e.output.substr(0, 2000);
+                               << (e.hung ? " (hung)" : "") << "\n"
+                               << e.output.substr(0, 2000);
   // echoed values are capped: a 1 MB value never makes a 1 MB message
   EXPECT_LT(e.output.size(), 4000u) << what.substr(0, 200);
   return o;
@@ -294,7 +317,8 @@ TEST(ConfigCorpus, EveryMalformedInputExitsWithAMessageNamingTheProblem) {
       {{"--set", "grid.n=1024"}, "grid.n = 1024", 4 * gib},
       {{"--set", "grid.n=512"}, "grid.n = 512", 2 * gib},
       {{"--set", "grid.n=8", "--set", "grid.box_A=4e6", "--set", "rod.base_pairs=1000000"},
-       "rod.base_pairs", gib / 4},
+       "rod.base_pairs",
+       gib / 4},
   };
   for (const auto& c : cli) {
     const fs::path out = d / ("cli" + std::to_string(i++));
@@ -309,12 +333,13 @@ TEST(ConfigCorpus, EveryMalformedInputExitsWithAMessageNamingTheProblem) {
   if (::geteuid() != 0) {
     std::ofstream(ro) << "[grid]\nn = 16\n";
     fs::permissions(ro, fs::perms::none);
-    t.add(classify({"run", ro.string(), "-o", (d / "ro").string()}, "Permission denied",
-                   d / "ro", d / "log", "unreadable CONFIG"));
+    t.add(classify({"run", ro.string(), "-o", (d / "ro").string()}, "Permission denied", d / "ro",
+                   d / "log", "unreadable CONFIG"));
   }
-  std::printf("config corpus: %d inputs tried / %d clean errors naming the key / %d crashes / "
-              "%d hangs / %d accepted nonsense (%d errors not naming the key)\n",
-              t.tried, t.clean, t.crashes, t.hangs, t.accepted, t.unnamed);
+  std::printf(
+      "config corpus: %d inputs tried / %d clean errors naming the key / %d crashes / "
+      "%d hangs / %d accepted nonsense (%d errors not naming the key)\n",
+      t.tried, t.clean, t.crashes, t.hangs, t.accepted, t.unnamed);
   EXPECT_GE(t.tried, 200);
   EXPECT_EQ(t.clean, t.tried);
   fs::remove_all(d);
@@ -323,13 +348,13 @@ TEST(ConfigCorpus, EveryMalformedInputExitsWithAMessageNamingTheProblem) {
 TEST(ConfigCorpus, BadCommandLinesExitWithStatus2) {
   const fs::path d = fresh_dir("cli");
   const std::vector<std::vector<std::string>> cases = {
-      {"run", "--set", "grid.n"},                        // no value
-      {"run", "--set", "grid.n=abc"},                    // not TOML
-      {"run", "--set", "nosuch.key=1"},                  // unknown key
-      {"run", (d / "missing.toml").string()},            // no such file
-      {"run", "--resume", d.string(), "-o", "x"},        // --resume takes its own directory
-      {"run", "--force"},                                // --force needs --resume
-      {"run", "--resume", (d / "nothing").string()},     // no run there
+      {"run", "--set", "grid.n"},                     // no value
+      {"run", "--set", "grid.n=abc"},                 // not TOML
+      {"run", "--set", "nosuch.key=1"},               // unknown key
+      {"run", (d / "missing.toml").string()},         // no such file
+      {"run", "--resume", d.string(), "-o", "x"},     // --resume takes its own directory
+      {"run", "--force"},                             // --force needs --resume
+      {"run", "--resume", (d / "nothing").string()},  // no run there
       {"run", "--fftw-wisdom", (d / "none").string(), "-o", (d / "o").string()},
       {"frobnicate"},
   };

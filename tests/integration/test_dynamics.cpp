@@ -67,8 +67,7 @@ TEST(Dynamics, TotalEnergyNeverIncreasesAndLinkIsConserved) {
     prev = o;
   }
   EXPECT_GT(dissipated, 0.0);  // the perturbed ring is not at rest: something happened
-  for (const auto& D : s.rod().D)
-    ASSERT_LT((D.transpose() * D - Mat3::Identity()).norm(), 1e-10);
+  for (const auto& D : s.rod().D) ASSERT_LT((D.transpose() * D - Mat3::Identity()).norm(), 1e-10);
 }
 
 TEST(Dynamics, ChargedRodEnergyIncludingElectrostaticsNeverIncreases) {

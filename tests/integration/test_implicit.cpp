@@ -9,10 +9,10 @@
 #include <memory>
 #include <vector>
 
+#include "config/config.hpp"
 #include "diagnostics/topology.hpp"
 #include "helpers.hpp"
 #include "integrate/implicit.hpp"
-#include "config/config.hpp"
 
 namespace ibrod {
 namespace {
@@ -109,7 +109,8 @@ TEST(Implicit, TwentyTimesTheExplicitLimitThroughCollapseAndContact) {
   integrate::AdaptiveDtParams ap;
   ap.dt_max = 20 * kExplicitLimit;
   ap.dt_min = 1e-3 * kExplicitLimit;
-  ap.max_displacement = 0.2 * std::min(1 / r.p.stepper.electro.law.kappa, r.p.stepper.steric.diameter);
+  ap.max_displacement =
+      0.2 * std::min(1 / r.p.stepper.electro.law.kappa, r.p.stepper.steric.diameter);
   ap.energy_tolerance = 1e-6 * r.p.kT;
   integrate::AdaptiveDt ctl(ap);
   const double lk0 = link(r.rod);

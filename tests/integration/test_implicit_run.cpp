@@ -49,8 +49,8 @@ std::vector<double> column(const fs::path& csv, const std::string& name) {
 TEST(ImplicitRun, ReachesTheEndWithAnAdaptiveStepAndResumesBitwise) {
   const fs::path root = fresh_dir("implicit_run");
   std::ofstream(root / "in.toml") << implicit_config();
-  Exit e = run_ibrod({"run", (root / "in.toml").string(), "-o", (root / "A").string()},
-                     root / "A.log");
+  Exit e =
+      run_ibrod({"run", (root / "in.toml").string(), "-o", (root / "A").string()}, root / "A.log");
   ASSERT_EQ(e.code, 0) << e.output;
   EXPECT_THAT(read_file(root / "A" / "summary.json"), HasSubstr("\"stop_reason\": \"end_time\""));
   EXPECT_THAT(read_file(root / "A" / "config.toml"), HasSubstr("scheme = 'implicit'"));
@@ -64,7 +64,7 @@ TEST(ImplicitRun, ReachesTheEndWithAnAdaptiveStepAndResumesBitwise) {
   EXPECT_NEAR(t.back(), 0.3, 1e-12);  // the last step lands on t_end
   std::vector<double> dt;
   for (std::size_t i = 1; i < t.size(); ++i) {
-    ASSERT_GT(t[i], t[i - 1]) << i;  // continuous, increasing
+    ASSERT_GT(t[i], t[i - 1]) << i;       // continuous, increasing
     dt.push_back((t[i] - t[i - 1]) / 2);  // rows every 2 steps
     EXPECT_NEAR(lk[i], lk[0], 1e-3) << i;
     EXPECT_LE(E[i], E[i - 1] + 1e-4) << i;  // E_K is part of E_total; rows are 2 steps apart
@@ -94,19 +94,18 @@ TEST(ImplicitRun, ReachesTheEndWithAnAdaptiveStepAndResumesBitwise) {
 
 TEST(ImplicitRun, BenchSchemesEndsWithBothRates) {
   const fs::path root = fresh_dir("bench_schemes");
-  const Exit e = run_ibrod({"bench", "--schemes", "--steps", "40", "--implicit-ns", "40",
-                            "--set", "grid.n=16", "--set", "grid.box_A=200", "--set",
-                            "rod.base_pairs=100", "--set", "run.fftw_measure=false", "--set",
-                            "run.threads=1"},
+  const Exit e = run_ibrod({"bench", "--schemes", "--steps", "40", "--implicit-ns", "40", "--set",
+                            "grid.n=16", "--set", "grid.box_A=200", "--set", "rod.base_pairs=100",
+                            "--set", "run.fftw_measure=false", "--set", "run.threads=1"},
                            root / "bench.log");
   ASSERT_EQ(e.code, 0) << e.output;
   const std::string out = e.output;
   const auto pos = out.rfind("us_per_hour_explicit=");
   ASSERT_NE(pos, std::string::npos) << out;
   double ex = 0, im = 0;
-  ASSERT_EQ(std::sscanf(out.c_str() + pos, "us_per_hour_explicit=%lf us_per_hour_implicit=%lf",
-                        &ex, &im),
-            2)
+  ASSERT_EQ(
+      std::sscanf(out.c_str() + pos, "us_per_hour_explicit=%lf us_per_hour_implicit=%lf", &ex, &im),
+      2)
       << out;
   EXPECT_GT(ex, 0.0);
   EXPECT_GT(im, ex);  // 20× the step at a cost of about one explicit step each

@@ -43,9 +43,10 @@ bool mpi_usable() {
 // `mpirun -np ranks ibrod args…` (as root OpenMPI needs --allow-run-as-root; --oversubscribe:
 // more ranks than cores), output to log; a hang fails after 300 s. Returns the exit status.
 int mpirun(int ranks, const std::string& args, const fs::path& log) {
-  const std::string cmd = "OMP_WAIT_POLICY=passive timeout 300 mpirun --allow-run-as-root "
-                          "--oversubscribe -np " + std::to_string(ranks) + " " +
-                          IBROD_BINARY + " " + args + " > " + log.string() + " 2>&1";
+  const std::string cmd =
+      "OMP_WAIT_POLICY=passive timeout 300 mpirun --allow-run-as-root "
+      "--oversubscribe -np " +
+      std::to_string(ranks) + " " + IBROD_BINARY + " " + args + " > " + log.string() + " 2>&1";
   const int rc = std::system(cmd.c_str());
   return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
 }
@@ -107,19 +108,19 @@ TEST(MpiRun, TwoRanksShareTheFluidGridAndAgreeWithOneProcess) {
   if (!mpi_usable()) GTEST_SKIP() << "built without MPI, or no mpirun";
   const fs::path d = fresh_dir("mpi_run");
   std::ofstream(d / "tiny.toml") << tiny_config();
-  const auto one = run_ibrod({"run", (d / "tiny.toml").string(), "-o", (d / "one").string()},
-                             d / "one.log");
+  const auto one =
+      run_ibrod({"run", (d / "tiny.toml").string(), "-o", (d / "one").string()}, d / "one.log");
   ASSERT_EQ(one.code, 0) << one.output;
-  const int rc = mpirun(2, "run " + (d / "tiny.toml").string() + " -o " + (d / "two").string(),
-                        d / "two.log");
+  const int rc =
+      mpirun(2, "run " + (d / "tiny.toml").string() + " -o " + (d / "two").string(), d / "two.log");
   const std::string log = read_file(d / "two.log");
   ASSERT_EQ(rc, 0) << log;
   // rank 0 alone reports
   EXPECT_EQ(log.find("ibrod: stopped (end_time)"), log.rfind("ibrod: stopped (end_time)")) << log;
   expect_same_trajectory(d / "one", d / "two");
   // the same outputs as a one-process run (rank 0 wrote them)
-  for (const char* f : {"config.toml", "summary.json", "trajectory.h5", "checkpoint.bin",
-                        "fftw.wisdom", "rod.pvd"})
+  for (const char* f :
+       {"config.toml", "summary.json", "trajectory.h5", "checkpoint.bin", "fftw.wisdom", "rod.pvd"})
     EXPECT_TRUE(fs::exists(d / "two" / f)) << f;
   fs::remove_all(d);
 }
@@ -128,8 +129,8 @@ TEST(MpiRun, ARankCountThatDoesNotDivideTheGridIsAnInputErrorOnEveryRank) {
   if (!mpi_usable()) GTEST_SKIP() << "built without MPI, or no mpirun";
   const fs::path d = fresh_dir("mpi_run_k3");
   std::ofstream(d / "tiny.toml") << tiny_config();
-  const int rc = mpirun(3, "run " + (d / "tiny.toml").string() + " -o " + (d / "out").string(),
-                        d / "log");
+  const int rc =
+      mpirun(3, "run " + (d / "tiny.toml").string() + " -o " + (d / "out").string(), d / "log");
   const std::string log = read_file(d / "log");
   EXPECT_EQ(rc, 2) << log;
   // every rank stopped with the message (none hung: mpirun returned)
@@ -145,9 +146,9 @@ TEST(MpiRun, ABadConfigIsExit2OnEveryRank) {
   if (!mpi_usable()) GTEST_SKIP() << "built without MPI, or no mpirun";
   const fs::path d = fresh_dir("mpi_run_bad");
   std::ofstream(d / "tiny.toml") << tiny_config();
-  const int rc = mpirun(2, "run " + (d / "tiny.toml").string() + " --set time.dt_ns=-1 -o " +
-                               (d / "out").string(),
-                        d / "log");
+  const int rc = mpirun(
+      2, "run " + (d / "tiny.toml").string() + " --set time.dt_ns=-1 -o " + (d / "out").string(),
+      d / "log");
   EXPECT_EQ(rc, 2) << read_file(d / "log");
   fs::remove_all(d);
 }
@@ -165,9 +166,9 @@ TEST(MpiRun, CheckpointsMoveBetweenTwoRanksAndOneProcess) {
   // 50 steps on 2 ranks, the other 50 in one process
   ASSERT_EQ(mpirun(2, "run " + cfg + half + " -o " + (d / "a").string(), d / "a1.log"), 0)
       << read_file(d / "a1.log");
-  const auto a = run_ibrod({"run", "--resume", (d / "a").string(), "--set",
-                            "time.t_end_us=0.01", "--force"},
-                           d / "a2.log");
+  const auto a =
+      run_ibrod({"run", "--resume", (d / "a").string(), "--set", "time.t_end_us=0.01", "--force"},
+                d / "a2.log");
   ASSERT_EQ(a.code, 0) << a.output;
   expect_same_trajectory(d / "one", d / "a");
 

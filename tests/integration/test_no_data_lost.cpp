@@ -65,8 +65,8 @@ TEST(OneWriter, ASecondRunOrResumeOnALockedDirectoryIsRefusedNamingTheHolder) {
   const Exit resume = run_ibrod({"run", "--resume", out.string()}, d / "resume.log");
   EXPECT_EQ(resume.code, 2) << resume.output;
   EXPECT_THAT(resume.output, HasSubstr("PID " + std::to_string(first.pid)));
-  const Exit second = run_ibrod({"run", cfg.string(), "-o", out.string(), "--overwrite"},
-                                d / "second.log");
+  const Exit second =
+      run_ibrod({"run", cfg.string(), "-o", out.string(), "--overwrite"}, d / "second.log");
   EXPECT_EQ(second.code, 2) << second.output;
   EXPECT_THAT(second.output, HasSubstr("another ibrod process"));
   // the lock is visible to a sweep as a running point
@@ -137,9 +137,9 @@ TEST(TimeIsState, AChangedTimeStepOnResumeKeepsTheTimeContinuousAndMonotone) {
   const fs::path out = d / "out";
   ASSERT_EQ(run_ibrod({"run", cfg.string(), "-o", out.string()}, d / "a.log").code, 0);
   // continue to 0.016 us with Δt = 0.004 ns (was 0.1): 1000 more steps
-  const Exit r = run_ibrod({"run", "--resume", out.string(), "--force", "--set",
-                            "time.dt_ns=0.004", "--set", "time.t_end_us=0.016", "--set",
-                            "output.every_steps=250", "--set", "output.frame_every_steps=250"},
+  const Exit r = run_ibrod({"run", "--resume", out.string(), "--force", "--set", "time.dt_ns=0.004",
+                            "--set", "time.t_end_us=0.016", "--set", "output.every_steps=250",
+                            "--set", "output.frame_every_steps=250"},
                            d / "b.log");
   ASSERT_EQ(r.code, 0) << r.output;
   const auto t = column(out / "timeseries.csv", "time_us");
@@ -153,7 +153,8 @@ TEST(TimeIsState, AChangedTimeStepOnResumeKeepsTheTimeContinuousAndMonotone) {
   EXPECT_DOUBLE_EQ(step.back(), 1120);  // 120 steps of 0.1 ns, 1000 of 0.004 ns
   // the H5MD frames carry the same continuous time
   const io::H5mdSeries pos = io::read_h5md_series(out / "trajectory.h5", "position");
-  for (std::size_t i = 1; i < pos.time_us.size(); ++i) EXPECT_GT(pos.time_us[i], pos.time_us[i - 1]);
+  for (std::size_t i = 1; i < pos.time_us.size(); ++i)
+    EXPECT_GT(pos.time_us[i], pos.time_us[i - 1]);
   EXPECT_NEAR(pos.time_us.back(), 0.016, 1e-9);
   const std::string summary = read_file(out / "summary.json");
   const auto at = summary.find("\"time_us\": ");
@@ -169,9 +170,8 @@ TEST(TimeIsState, AnEndTimeBeforeTheCheckpointIsRefused) {
   const fs::path cfg = write_config(d, c, "c.toml");
   const fs::path out = d / "out";
   ASSERT_EQ(run_ibrod({"run", cfg.string(), "-o", out.string()}, d / "a.log").code, 0);
-  const Exit r = run_ibrod({"run", "--resume", out.string(), "--force", "--set",
-                            "time.t_end_us=0.005"},
-                           d / "b.log");
+  const Exit r = run_ibrod(
+      {"run", "--resume", out.string(), "--force", "--set", "time.t_end_us=0.005"}, d / "b.log");
   EXPECT_EQ(r.code, 2) << r.output;
   EXPECT_THAT(r.output, HasSubstr("time.t_end_us"));
   EXPECT_THAT(r.output, HasSubstr("cannot go back"));
@@ -210,8 +210,8 @@ TEST(DiskFull, BeforeTheFirstCheckpointTheAdviceIsOverwriteAndItWorks) {
       full.output.find("--overwrite") == std::string::npos)
     FAIL() << "advises --resume without a checkpoint: " << full.output;
   EXPECT_THAT(full.output, HasSubstr("--overwrite"));
-  const Exit again = run_ibrod({"run", cfg.string(), "-o", out.string(), "--overwrite"},
-                               d / "b.log");
+  const Exit again =
+      run_ibrod({"run", cfg.string(), "-o", out.string(), "--overwrite"}, d / "b.log");
   EXPECT_EQ(again.code, 0) << again.output;
   fs::remove_all(d);
 }
@@ -228,8 +228,7 @@ TEST(Extension, ALaterEndTimeAloneNeedsNoForceAndEqualsTheUninterruptedLongerRun
             0);
   ASSERT_EQ(run_ibrod({"run", short_cfg.string(), "-o", (d / "ext").string()}, d / "a.log").code,
             0);
-  const Exit e = run_ibrod({"run", "--resume", (d / "ext").string(), "--set",
-                            "time.t_end_us=0.09"},
+  const Exit e = run_ibrod({"run", "--resume", (d / "ext").string(), "--set", "time.t_end_us=0.09"},
                            d / "b.log");
   ASSERT_EQ(e.code, 0) << e.output;
   EXPECT_THAT(e.output, HasSubstr("extending the run"));

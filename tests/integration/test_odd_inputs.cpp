@@ -60,8 +60,9 @@ TEST(OddInputs, AnUnreadableConfigSaysPermissionDenied) {
 TEST(OddInputs, ControlCharactersInSetValuesAreRefused) {
   const fs::path d = fresh_dir("odd_ctl");
   // before: TOML read "v = 16" and a second key on the next line, and the rest was dropped
-  for (const std::string& set : std::vector<std::string>{
-           "grid.n=16\nrod.base_pairs=8", "grid.n=16\n", "grid.n=\t16", "grid.n=16\x01", "grid.n=1\r6"}) {
+  for (const std::string& set :
+       std::vector<std::string>{"grid.n=16\nrod.base_pairs=8", "grid.n=16\n", "grid.n=\t16",
+                                "grid.n=16\x01", "grid.n=1\r6"}) {
     const BoundedExit e = run_bounded({"check", "--set", set}, d / "log", 10);
     EXPECT_EQ(e.code, 2) << e.output;
     EXPECT_THAT(e.output, HasSubstr("control characters")) << e.output;
@@ -81,8 +82,9 @@ TEST(OddInputs, EchoedValuesAreCapped) {
   EXPECT_LT(e.output.size(), 2000u) << "a 1 MB value gave a message of " << e.output.size();
   // argv strings are limited to 128 KiB (MAX_ARG_STRLEN): a 100 KB key and value
   const std::string long_value(100000, '7');
-  for (const std::string& set : std::vector<std::string>{
-           "grid.n=" + long_value, "grid." + huge.substr(0, 100000) + "=1", "grid.n=\"" + long_value}) {
+  for (const std::string& set :
+       std::vector<std::string>{"grid.n=" + long_value, "grid." + huge.substr(0, 100000) + "=1",
+                                "grid.n=\"" + long_value}) {
     e = run_bounded({"check", "--set", set}, d / "log", 20);
     EXPECT_EQ(e.code, 2);
     EXPECT_LT(e.output.size(), 2000u) << set.substr(0, 20) << ": " << e.output.size();

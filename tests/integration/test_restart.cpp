@@ -6,9 +6,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "helpers.hpp"
 #include "io/checkpoint.hpp"
 #include "io/h5md.hpp"
-#include "helpers.hpp"
 #include "run_helpers.hpp"
 
 using namespace ibrod;
@@ -61,8 +61,8 @@ class Restart : public ::testing::Test {
   // A run that shares the reference's FFTW plans (FFTW_MEASURE may choose other plans in
   // another process, and other plans round differently).
   std::vector<std::string> run_args(const std::string& out) const {
-    return {"run", (root_ / "in.toml").string(), "-o", (root_ / out).string(), "--fftw-wisdom",
-            (ref() / "fftw.wisdom").string()};
+    return {"run",           (root_ / "in.toml").string(),    "-o", (root_ / out).string(),
+            "--fftw-wisdom", (ref() / "fftw.wisdom").string()};
   }
 };
 fs::path Restart::root_;
@@ -193,8 +193,8 @@ TEST(SafeFailure, ATimeStepFarTooLargeStopsWithinOneOutputInterval) {
   std::ofstream(d / "in.toml") << "[grid]\nn = 16\nbox_A = 200\n[rod]\nbase_pairs = 100\n"
                                   "[time]\ndt_ns = 2\nt_end_us = 2\n[output]\nevery_steps = 100\n"
                                   "[run]\nfftw_measure = false\n";
-  const Exit e = run_ibrod({"run", (d / "in.toml").string(), "-o", (d / "out").string()},
-                           d / "log");
+  const Exit e =
+      run_ibrod({"run", (d / "in.toml").string(), "-o", (d / "out").string()}, d / "log");
   EXPECT_EQ(e.code, 3) << e.output;
   EXPECT_THAT(e.output, HasSubstr("blow-up at step"));
   EXPECT_THAT(e.output, HasSubstr("time step is probably too large"));

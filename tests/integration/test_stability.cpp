@@ -47,9 +47,9 @@ TEST(StabilityTest, AnUnstableCircleIsNotCalledAnEquilibriumAndBuckles) {
   const fs::path d = fresh_dir("stability_unstable");
   const fs::path cfg = circle_config(d, 3);
   // without the test: the run stops on the unstable circle
-  const Exit off = run_ibrod({"run", cfg.string(), "-o", (d / "off").string(), "--set",
-                              "time.stability_test=false"},
-                             d / "off.log");
+  const Exit off = run_ibrod(
+      {"run", cfg.string(), "-o", (d / "off").string(), "--set", "time.stability_test=false"},
+      d / "off.log");
   ASSERT_EQ(off.code, 0) << off.output;
   EXPECT_THAT(read_file(d / "off" / "summary.json"), HasSubstr("\"stop_reason\": \"equilibrium\""));
   EXPECT_LT(std::abs(final_writhe(d / "off")), 1e-3);

@@ -1,7 +1,7 @@
-// Sweeps end to end (driver/sweep_runner.hpp, `ibrod sweep`): the points run as real `ibrod run` processes;
-// a sweep stopped part-way and started again finishes every point exactly once (finished points
-// skipped, the interrupted one resumed from its checkpoint, bitwise as if never stopped); a failed
-// point is reported and the others finish; under mpirun the ranks share the points.
+// Sweeps end to end (driver/sweep_runner.hpp, `ibrod sweep`): the points run as real `ibrod run`
+// processes; a sweep stopped part-way and started again finishes every point exactly once (finished
+// points skipped, the interrupted one resumed from its checkpoint, bitwise as if never stopped); a
+// failed point is reported and the others finish; under mpirun the ranks share the points.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -163,13 +163,15 @@ TEST(SweepRun, APointDirectoryOfAnotherConfigurationIsNotTouched) {
   std::ofstream(d / "sweep.toml")
       << "[grid]\nn = 16\nbox_A = 200\n[rod]\nbase_pairs = 100\n[time]\nt_end_us = 0.01\n"
          "[run]\nthreads = 1\nfftw_measure = false\n[sweep]\n\"rod.excess_link\" = [3]\n";
-  ASSERT_EQ(driver::run_sweep(driver::load_sweep(d / "sweep.toml"), options(d / "out", 1)).completed, 1);
+  ASSERT_EQ(
+      driver::run_sweep(driver::load_sweep(d / "sweep.toml"), options(d / "out", 1)).completed, 1);
   // the same point name with another base value (t_end): refused, left as it is
   std::ofstream(d / "sweep.toml")
       << "[grid]\nn = 16\nbox_A = 200\n[rod]\nbase_pairs = 100\n[time]\nt_end_us = 0.02\n"
          "[run]\nthreads = 1\nfftw_measure = false\n[sweep]\n\"rod.excess_link\" = [3]\n";
   const std::string before = read_file(d / "out" / "dlk=3" / "summary.json");
-  const driver::SweepReport r = driver::run_sweep(driver::load_sweep(d / "sweep.toml"), options(d / "out", 1));
+  const driver::SweepReport r =
+      driver::run_sweep(driver::load_sweep(d / "sweep.toml"), options(d / "out", 1));
   EXPECT_EQ(r.failed, 1);
   EXPECT_EQ(read_file(d / "out" / "dlk=3" / "summary.json"), before);
   fs::remove_all(d);
@@ -179,10 +181,12 @@ TEST(SweepCommand, RunsEveryPointAndRejectsABadFileNamingTheKey) {
   if (!sweep_command_wired()) GTEST_SKIP() << "`ibrod sweep` is not wired into app/main.cpp yet";
   const fs::path d = fresh_dir("sweep_cmd");
   // `output_dir` is a top-level key: it comes before the first section
-  std::ofstream(d / "sweep.toml") << "output_dir = \"" << (d / "out").string() << "\"\n" << tiny_sweep();
+  std::ofstream(d / "sweep.toml") << "output_dir = \"" << (d / "out").string() << "\"\n"
+                                  << tiny_sweep();
   Exit e = run_ibrod({"sweep", (d / "sweep.toml").string(), "-j", "2"}, d / "log");
   ASSERT_EQ(e.code, 0) << e.output;
-  for (const char* n : {"dlk=1_salt_M=0.05", "dlk=1_salt_M=0.1", "dlk=2_salt_M=0.05", "dlk=2_salt_M=0.1"})
+  for (const char* n :
+       {"dlk=1_salt_M=0.05", "dlk=1_salt_M=0.1", "dlk=2_salt_M=0.05", "dlk=2_salt_M=0.1"})
     EXPECT_EQ(stop_reason(d / "out" / n), "end_time") << n;
   e = run_ibrod({"sweep", (d / "sweep.toml").string()}, d / "log2");
   EXPECT_EQ(e.code, 0) << e.output;
@@ -200,7 +204,8 @@ TEST(SweepCommand, RunsEveryPointAndRejectsABadFileNamingTheKey) {
   std::ofstream(d / "fail.toml")
       << "output_dir = \"" << (d / "fail").string() << "\"\n"
       << "[grid]\nn = 16\nbox_A = 200\n[rod]\nbase_pairs = 100\nexcess_link = 2\n[time]\n"
-         "t_end_us = 0.2\n[run]\nthreads = 1\nfftw_measure = false\n[sweep]\n\"time.dt_ns\" = [2.0, 0.1]\n";
+         "t_end_us = 0.2\n[run]\nthreads = 1\nfftw_measure = false\n[sweep]\n\"time.dt_ns\" = "
+         "[2.0, 0.1]\n";
   e = run_ibrod({"sweep", (d / "fail.toml").string(), "-j", "2"}, d / "log5");
   EXPECT_NE(e.code, 0) << e.output;
   EXPECT_THAT(e.output, HasSubstr("point dt_ns=2 failed"));
@@ -215,7 +220,8 @@ TEST(SweepCommand, UnderMpirunTheRanksShareThePoints) {
 #else
   if (std::system("command -v mpirun > /dev/null 2>&1") != 0) GTEST_SKIP() << "no mpirun";
   const fs::path d = fresh_dir("sweep_mpi");
-  std::ofstream(d / "sweep.toml") << "output_dir = \"" << (d / "out").string() << "\"\n" << tiny_sweep();
+  std::ofstream(d / "sweep.toml") << "output_dir = \"" << (d / "out").string() << "\"\n"
+                                  << tiny_sweep();
   // 2 local ranks (as root mpirun needs --allow-run-as-root; --oversubscribe: 2 cores or fewer)
   const int rc = std::system(("mpirun --allow-run-as-root --oversubscribe -np 2 " +
                               std::string(IBROD_BINARY) + " sweep " + (d / "sweep.toml").string() +
@@ -226,7 +232,8 @@ TEST(SweepCommand, UnderMpirunTheRanksShareThePoints) {
   EXPECT_THAT(log, HasSubstr("sweep[0]: 2 points (rank 0 of 2)"));
   EXPECT_THAT(log, HasSubstr("sweep[1]: 2 points (rank 1 of 2)"));
   EXPECT_THAT(log, HasSubstr("all ranks: 4 points, 4 finished now"));
-  for (const char* n : {"dlk=1_salt_M=0.05", "dlk=1_salt_M=0.1", "dlk=2_salt_M=0.05", "dlk=2_salt_M=0.1"})
+  for (const char* n :
+       {"dlk=1_salt_M=0.05", "dlk=1_salt_M=0.1", "dlk=2_salt_M=0.05", "dlk=2_salt_M=0.1"})
     EXPECT_EQ(stop_reason(d / "out" / n), "end_time") << n;
   fs::remove_all(d);
 #endif
@@ -267,23 +274,20 @@ TEST(SweepRun, PointKRunsThatPointAloneAndListNumbersThem) {
                               d / "list.log");
   ASSERT_EQ(list.code, 0) << list.output;
   EXPECT_THAT(list.output, ::testing::HasSubstr("   2  " + sw.points[2].name));
-  const Exit one = run_ibrod({"sweep", (d / "sweep.toml").string(), "-o", root.string(),
-                              "--point", "2"},
-                             d / "one.log");
+  const Exit one = run_ibrod(
+      {"sweep", (d / "sweep.toml").string(), "-o", root.string(), "--point", "2"}, d / "one.log");
   ASSERT_EQ(one.code, 0) << one.output;
   for (std::size_t i = 0; i < sw.points.size(); ++i)
     EXPECT_EQ(driver::point_state(root / sw.points[i].name),
               i == 2 ? driver::PointState::finished : driver::PointState::fresh)
         << sw.points[i].name;
   // again: skipped as finished; a point that does not exist is refused
-  const Exit again = run_ibrod({"sweep", (d / "sweep.toml").string(), "-o", root.string(),
-                                "--point", "2"},
-                               d / "again.log");
+  const Exit again = run_ibrod(
+      {"sweep", (d / "sweep.toml").string(), "-o", root.string(), "--point", "2"}, d / "again.log");
   EXPECT_EQ(again.code, 0);
   EXPECT_THAT(again.output, ::testing::HasSubstr("1 finished, 0 to run"));
-  const Exit bad = run_ibrod({"sweep", (d / "sweep.toml").string(), "-o", root.string(),
-                              "--point", "4"},
-                             d / "bad.log");
+  const Exit bad = run_ibrod(
+      {"sweep", (d / "sweep.toml").string(), "-o", root.string(), "--point", "4"}, d / "bad.log");
   EXPECT_EQ(bad.code, 2) << bad.output;
   EXPECT_THAT(bad.output, ::testing::HasSubstr("--point 4"));
   fs::remove_all(d);

@@ -82,7 +82,7 @@ TEST(Threads, SplitFluidStepEqualsStep) {
   std::normal_distribution<double> nd(0.0, 1.0);
   const std::size_t n3 = g.size();
   std::vector<double> u(3 * n3), f(3 * n3);
-  for (auto& v : u) v = 1e7 * nd(rng);  // Å/s: strong enough that advection matters
+  for (auto& v : u) v = 1e7 * nd(rng);    // Å/s: strong enough that advection matters
   for (auto& v : f) v = 1e-17 * nd(rng);  // g Å⁻² s⁻²
   for (int comp = 0; comp < 3; ++comp) {
     std::copy_n(u.begin() + comp * n3, n3, a.velocity(comp));

@@ -39,13 +39,15 @@ Outcome run(const config::Config& c, double t_max_us, int every, Until until) {
     out.last = o;
     out.max_link_error = std::max(out.max_link_error, std::abs(o.link - dlk));
     out.min_closest = std::min(out.min_closest, o.closest_approach_A);
-    if (!sim::rod_problem(s.rod(), c.rod_rise_A).empty() || !std::isfinite(o.E_total_kT) || until(o) || o.time_us >= t_max_us) break;
+    if (!sim::rod_problem(s.rod(), c.rod_rise_A).empty() || !std::isfinite(o.E_total_kT) ||
+        until(o) || o.time_us >= t_max_us)
+      break;
   }
-  std::printf("  ΔLk = %d, Cs = %g M: t = %.2f µs, Wr = %.4f, Lk = %.6f, closest %.2f Å, spacing "
-              "%.4f Å, E_K = %.3e kT\n",
-              c.rod_excess_link, c.solvent_salt_M, out.last.time_us, out.last.writhe,
-              out.last.link, out.last.closest_approach_A, out.last.bp_spacing_A,
-              out.last.E_kinetic_kT);
+  std::printf(
+      "  ΔLk = %d, Cs = %g M: t = %.2f µs, Wr = %.4f, Lk = %.6f, closest %.2f Å, spacing "
+      "%.4f Å, E_K = %.3e kT\n",
+      c.rod_excess_link, c.solvent_salt_M, out.last.time_us, out.last.writhe, out.last.link,
+      out.last.closest_approach_A, out.last.bp_spacing_A, out.last.E_kinetic_kT);
   return out;
 }
 
@@ -69,8 +71,10 @@ TEST(Reference, TwistedRingsBuckleOutOfPlaneKeepingTheirLink) {
 // stay farther apart and adjacent base pairs are pushed farther apart.
 TEST(Reference, LowerSaltKeepsStrandsFartherApart) {
   const double t_us = 30.0;
-  const auto high = run(reference(3, 0.1), t_us, 2000, [](const sim::Observables&) { return false; });
-  const auto low = run(reference(3, 0.01), t_us, 2000, [](const sim::Observables&) { return false; });
+  const auto high =
+      run(reference(3, 0.1), t_us, 2000, [](const sim::Observables&) { return false; });
+  const auto low =
+      run(reference(3, 0.01), t_us, 2000, [](const sim::Observables&) { return false; });
   EXPECT_GT(high.last.writhe, 0.5);  // collapsed within the window
   EXPECT_LT(high.max_link_error, 1e-3);
   EXPECT_LT(low.max_link_error, 1e-3);

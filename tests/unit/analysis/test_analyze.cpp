@@ -1,7 +1,7 @@
-// Post-processing of a run directory (analysis/analyze.hpp, analysis/frames.hpp) on synthetic files: CSV reading (a row cut
-// short by a killed run is dropped, a malformed one is an error), the analysis of a series with
-// known answers, the atomic merge into summary.json (other keys kept, bad JSON refused and left
-// untouched), config.toml, --size, and render_run on a known ring.
+// Post-processing of a run directory (analysis/analyze.hpp, analysis/frames.hpp) on synthetic
+// files: CSV reading (a row cut short by a killed run is dropped, a malformed one is an error), the
+// analysis of a series with known answers, the atomic merge into summary.json (other keys kept, bad
+// JSON refused and left untouched), config.toml, --size, and render_run on a known ring.
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -17,9 +17,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "core/error.hpp"
 #include "analysis/analyze.hpp"
 #include "analysis/frames.hpp"
+#include "core/error.hpp"
 #include "render/image.hpp"
 
 namespace ibrod::analysis {
@@ -30,7 +30,8 @@ namespace fs = std::filesystem;
 struct TempDir {
   fs::path path;
   explicit TempDir(const std::string& name)
-      : path(fs::temp_directory_path() / ("ibrod_analyze_" + name + "_" + std::to_string(::getpid()))) {
+      : path(fs::temp_directory_path() /
+             ("ibrod_analyze_" + name + "_" + std::to_string(::getpid()))) {
     fs::remove_all(path);
     fs::create_directories(path);
   }
@@ -107,12 +108,14 @@ TEST(Analyze, KnownAnswersOfASyntheticSeries) {
 TEST(Analyze, MergesIntoSummaryAtomicallyAndKeepsOtherKeys) {
   TempDir d("summary");
   write(d.path / "timeseries.csv", synthetic_timeseries(201, 0.01));
-  write(d.path / "summary.json", R"({"steps": 2000, "stop_reason": "equilibrium", "writhe_convergence_time_us": 99})");
+  write(d.path / "summary.json",
+        R"({"steps": 2000, "stop_reason": "equilibrium", "writhe_convergence_time_us": 99})");
   analyze_run(d.path);
   const auto j = nlohmann::json::parse(read_file(d.path / "summary.json"));
   EXPECT_EQ(j["steps"], 2000);
   EXPECT_EQ(j["stop_reason"], "equilibrium");
-  EXPECT_NEAR(j["writhe_convergence_time_us"].get<double>(), 0.1 * std::log(80.0), 1e-3);  // replaced
+  EXPECT_NEAR(j["writhe_convergence_time_us"].get<double>(), 0.1 * std::log(80.0),
+              1e-3);  // replaced
   EXPECT_NEAR(j["relaxation_time_us"].get<double>(), 0.25, 1e-6);
   EXPECT_TRUE(j["transients"].is_array());
   EXPECT_TRUE(j["kinetic_power_law_exponent"].is_null());
@@ -172,7 +175,9 @@ TEST(Analyze, CircularRunGetsAPowerLaw) {
   const auto j = nlohmann::json::parse(read_file(d.path / "summary.json"));  // created
   EXPECT_NEAR(j["kinetic_power_law_exponent"].get<double>(), -1.5, 1e-6);
   // Wr constant: inside the band from the start
-  EXPECT_EQ(analyze_timeseries(read_csv_table(d.path / "timeseries.csv")).writhe_convergence_time_us, 0.0);
+  EXPECT_EQ(
+      analyze_timeseries(read_csv_table(d.path / "timeseries.csv")).writhe_convergence_time_us,
+      0.0);
 }
 
 TEST(Analyze, UnfinishedRunGivesNullWithAReasonNeverANumber) {
@@ -190,9 +195,9 @@ TEST(Analyze, UnfinishedRunGivesNullWithAReasonNeverANumber) {
     const auto j = nlohmann::json::parse(read_file(d.path / "summary.json"));
     EXPECT_EQ(j["equilibrium_reached"], false);
     EXPECT_NE(j["not_finished_reason"].get<std::string>().find(reason), std::string::npos);
-    for (const char* key : {"writhe_convergence_time_us", "relaxation_time_us", "relaxation_fit",
-                            "relaxation_time_contacts_us", "relaxation_time_table_us",
-                            "limiting_energies_kT"})
+    for (const char* key :
+         {"writhe_convergence_time_us", "relaxation_time_us", "relaxation_fit",
+          "relaxation_time_contacts_us", "relaxation_time_table_us", "limiting_energies_kT"})
       EXPECT_TRUE(j[key].is_null()) << reason << ": " << key << " = " << j[key];
     EXPECT_FALSE(j["final_energies_kT"].is_null());  // the last row's values, as they are
   }
@@ -209,7 +214,8 @@ TEST(Analyze, UnfinishedRunGivesNullWithAReasonNeverANumber) {
   // no trajectory: the table's τ is the final-window fit, and the summary says so
   EXPECT_EQ(j["relaxation_time_method"], "final_window");
   EXPECT_NEAR(j["relaxation_time_table_us"].get<double>(), 0.25, 1e-6);
-  EXPECT_NE(j["relaxation_contacts_note"].get<std::string>().find("no trajectory.h5"), std::string::npos);
+  EXPECT_NE(j["relaxation_contacts_note"].get<std::string>().find("no trajectory.h5"),
+            std::string::npos);
   EXPECT_TRUE(j["contacts"]["source"].is_null());
 }
 
@@ -222,7 +228,8 @@ TEST(Analyze, RelaxationTimeAfterTheLastContactChange) {
   os.precision(15);
   for (int i = 0; i <= 300; ++i) {
     const double t = 0.01 * i;
-    const double ek = t < 1 ? std::exp(-2 * t / 0.1) : std::exp(-2 / 0.1) * std::exp(-2 * (t - 1) / 0.5);
+    const double ek =
+        t < 1 ? std::exp(-2 * t / 0.1) : std::exp(-2 / 0.1) * std::exp(-2 * (t - 1) / 0.5);
     os << i << "," << t << ",1,1,1,1,0,0," << ek << "," << 4 + ek << ",0.5,1,1,50,3.4\n";
   }
   write(d.path / "timeseries.csv", os.str());

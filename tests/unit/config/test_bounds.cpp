@@ -89,7 +89,7 @@ TEST(Bounds, DerivedCountsThatWouldOverflowAreRefusedNamingTheKey) {
 // Item 6: before, rod.excess_link = 500 with 600 points built a rod of link −100 (2π·500/600
 // per segment is past π and wraps).
 TEST(Bounds, ALinkTheDiscretizationCannotRepresentIsRefused) {
-  config::Config c;  // 600 base pairs
+  config::Config c;                                  // 600 base pairs
   EXPECT_EQ(refusal(c, "rod.excess_link=150"), "");  // π/2 per segment
   EXPECT_THAT(refusal(c, "rod.excess_link=151"), HasSubstr("rod.excess_link"));
   EXPECT_THAT(refusal(c, "rod.excess_link=-151"), HasSubstr("rod.base_pairs / 4 = 150"));
@@ -107,12 +107,12 @@ TEST(Bounds, ALinkTheDiscretizationCannotRepresentIsRefused) {
 // Item 8: before, each of these at 1e308 passed `check` and blew up at step 0.
 TEST(Bounds, ValuesAStepCannotRepresentAreRefusedWithTheRange) {
   const config::Config c;
-  for (const char* key : {"grid.box_A", "rod.bend_modulus_erg_cm", "rod.twist_modulus_erg_cm",
-                          "rod.shear_modulus_dyn", "rod.stretch_modulus_dyn", "rod.rise_A",
-                          "electrostatics.charge_e", "electrostatics.dielectric",
-                          "electrostatics.cutoff_debye", "solvent.viscosity_poise",
-                          "solvent.density_g_cm3", "solvent.temperature_K", "steric.diameter_A",
-                          "steric.stiffness", "time.stop_kinetic_kT"}) {
+  for (const char* key :
+       {"grid.box_A", "rod.bend_modulus_erg_cm", "rod.twist_modulus_erg_cm",
+        "rod.shear_modulus_dyn", "rod.stretch_modulus_dyn", "rod.rise_A", "electrostatics.charge_e",
+        "electrostatics.dielectric", "electrostatics.cutoff_debye", "solvent.viscosity_poise",
+        "solvent.density_g_cm3", "solvent.temperature_K", "steric.diameter_A", "steric.stiffness",
+        "time.stop_kinetic_kT"}) {
     const std::string msg = refusal(c, std::string(key) + "=1e308");
     EXPECT_THAT(msg, HasSubstr(key)) << key;
     EXPECT_THAT(msg, HasSubstr("<= ")) << key << ": the message gives the range";
@@ -129,13 +129,20 @@ TEST(Bounds, AtEveryBoundTheFirstStepStaysFinite) {
     double ref;
     bool zero;
   } keys[] = {
-      {"rod.bend_modulus_erg_cm", 1.3e-19, false}, {"rod.twist_modulus_erg_cm", 1.82e-19, false},
-      {"rod.shear_modulus_dyn", 5e-5, false},      {"rod.stretch_modulus_dyn", 5e-5, false},
-      {"solvent.viscosity_poise", 0.01, false},    {"solvent.density_g_cm3", 1.0, false},
-      {"solvent.temperature_K", 300, false},       {"electrostatics.charge_e", 0.48, true},
-      {"electrostatics.dielectric", 77.7, false},  {"electrostatics.cutoff_debye", 16, false},
-      {"steric.stiffness", 0.1, true},             {"steric.diameter_A", 20, false},
-      {"rod.rise_A", 3.4, false},                  {"grid.box_A", 725, false},
+      {"rod.bend_modulus_erg_cm", 1.3e-19, false},
+      {"rod.twist_modulus_erg_cm", 1.82e-19, false},
+      {"rod.shear_modulus_dyn", 5e-5, false},
+      {"rod.stretch_modulus_dyn", 5e-5, false},
+      {"solvent.viscosity_poise", 0.01, false},
+      {"solvent.density_g_cm3", 1.0, false},
+      {"solvent.temperature_K", 300, false},
+      {"electrostatics.charge_e", 0.48, true},
+      {"electrostatics.dielectric", 77.7, false},
+      {"electrostatics.cutoff_debye", 16, false},
+      {"steric.stiffness", 0.1, true},
+      {"steric.diameter_A", 20, false},
+      {"rod.rise_A", 3.4, false},
+      {"grid.box_A", 725, false},
   };
   int built = 0;
   for (const auto& k : keys) {

@@ -3,8 +3,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "core/error.hpp"
 #include "config/config.hpp"
+#include "core/error.hpp"
 
 using namespace ibrod;
 using ::testing::HasSubstr;
@@ -97,7 +97,8 @@ TEST(Config, UnknownKeysAndSectionsAreErrors) {
 
 TEST(Config, BrokenTomlReportsTheLine) {
   config::Config c;
-  const auto msg = error_of([&] { config::apply_toml(c, "[grid]\nn = 64\nbox_A = = 3\n", "bad.toml"); });
+  const auto msg =
+      error_of([&] { config::apply_toml(c, "[grid]\nn = 64\nbox_A = = 3\n", "bad.toml"); });
   EXPECT_THAT(msg, HasSubstr("bad.toml:3"));
   EXPECT_THAT(msg, HasSubstr("TOML"));
 }

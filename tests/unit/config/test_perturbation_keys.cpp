@@ -15,9 +15,9 @@ using ::testing::HasSubstr;
 TEST(RandomPerturbation, IsAddedToTheDeterministicListAndRecordedInConfigToml) {
   config::Config c;
   config::apply_toml(c,
-                 "[rod]\nperturbation = [1.0]\n"
-                 "perturbation_random = { modes = 3, amplitude = 0.25, seed = 11 }\n",
-                 "test");
+                     "[rod]\nperturbation = [1.0]\n"
+                     "perturbation_random = { modes = 3, amplitude = 0.25, seed = 11 }\n",
+                     "test");
   const auto drawn = rod::draw_perturbation({3, 0.25, 11});
   const auto p = config::to_params(c);
   ASSERT_EQ(p.circle.perturbation.size(), 3u);
@@ -29,7 +29,8 @@ TEST(RandomPerturbation, IsAddedToTheDeterministicListAndRecordedInConfigToml) {
   config::apply_toml(again, config::to_toml(c), "config.toml");
   EXPECT_EQ(again.rod_perturbation_random, c.rod_perturbation_random);
   EXPECT_EQ(config::to_params(again).circle.perturbation, p.circle.perturbation);
-  EXPECT_THAT(config::to_toml(c), HasSubstr("perturbation_random = { amplitude = 0.25, modes = 3, seed = 11 }"));
+  EXPECT_THAT(config::to_toml(c),
+              HasSubstr("perturbation_random = { amplitude = 0.25, modes = 3, seed = 11 }"));
   // ibrod check shows the drawn values
   EXPECT_THAT(config::describe(c), HasSubstr("-> eps = ["));
 }

@@ -29,10 +29,10 @@ TEST(SchemeKeys, ExplicitByDefaultImplicitOnRequest) {
   EXPECT_EQ(p.implicit.jacobian_every, 2);
   EXPECT_EQ(p.implicit.krylov_max_iter, 5);
   EXPECT_THAT(config::to_toml(c), HasSubstr("scheme = 'implicit'"));
-  for (const char* k : {"time.scheme", "time.max_displacement_A", "time.energy_tolerance_kT",
-                        "time.dt_min_ns", "time.implicit_mobility_scale",
-                        "time.implicit_jacobian_every", "time.implicit_krylov_iterations",
-                        "time.implicit_krylov_tol"})
+  for (const char* k :
+       {"time.scheme", "time.max_displacement_A", "time.energy_tolerance_kT", "time.dt_min_ns",
+        "time.implicit_mobility_scale", "time.implicit_jacobian_every",
+        "time.implicit_krylov_iterations", "time.implicit_krylov_tol"})
     EXPECT_THAT(config::describe(c), HasSubstr(k));
 }
 

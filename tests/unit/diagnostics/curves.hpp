@@ -50,7 +50,8 @@ inline SmoothCurve random_fourier_curve(std::mt19937_64& rng, int modes) {
   SmoothCurve C;
   C.r = [a, b](double t) {
     Vec3 x = Vec3::Zero();
-    for (int k = 0; k < int(a.size()); ++k) x += a[k] * std::cos((k + 1) * t) + b[k] * std::sin((k + 1) * t);
+    for (int k = 0; k < int(a.size()); ++k)
+      x += a[k] * std::cos((k + 1) * t) + b[k] * std::sin((k + 1) * t);
     return x;
   };
   C.dr = [a, b](double t) {

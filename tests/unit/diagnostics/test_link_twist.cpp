@@ -33,10 +33,12 @@ TEST(LinkingNumber, UnlinkedCirclesGiveZero) {
   const auto A = circle(120, 1.0);
   const Vec3 e2 = Vec3(0, 1, 1).normalized();
   // side by side, tilted
-  EXPECT_NEAR(linking_number(A, circle(90, 1.0, Vec3(2.5, 0.0, 0.3), Vec3::UnitX(), e2)), 0.0, 1e-12);
+  EXPECT_NEAR(linking_number(A, circle(90, 1.0, Vec3(2.5, 0.0, 0.3), Vec3::UnitX(), e2)), 0.0,
+              1e-12);
   // stacked above A's disk, slightly tilted, never piercing it
   const Vec3 f2 = Vec3(0, 1, 0.1).normalized();
-  EXPECT_NEAR(linking_number(A, circle(90, 0.8, Vec3(0.1, 0.0, 0.5), Vec3::UnitX(), f2)), 0.0, 1e-12);
+  EXPECT_NEAR(linking_number(A, circle(90, 0.8, Vec3(0.1, 0.0, 0.5), Vec3::UnitX(), f2)), 0.0,
+              1e-12);
   // a big circle around a small one, coplanar-ish: not linked either
   EXPECT_NEAR(linking_number(A, circle(90, 3.0, Vec3(0, 0, 0.01), Vec3::UnitX(), f2)), 0.0, 1e-12);
 }
@@ -46,7 +48,8 @@ std::vector<Vec3> torus_strand(int n, int q, int c, double R = 2.0, double r = 0
   std::vector<Vec3> X(n);
   for (int k = 0; k < n; ++k) {
     const double t = 2 * pi * k / n, phi = q * t + c * pi;
-    X[k] = Vec3((R + r * std::cos(phi)) * std::cos(t), (R + r * std::cos(phi)) * std::sin(t), r * std::sin(phi));
+    X[k] = Vec3((R + r * std::cos(phi)) * std::cos(t), (R + r * std::cos(phi)) * std::sin(t),
+                r * std::sin(phi));
   }
   return X;
 }
@@ -108,8 +111,8 @@ std::vector<Vec3> random_ribbon(const std::vector<Vec3>& X, int m, std::mt19937_
   std::vector<Vec3> d1(n);
   for (int k = 0; k < n; ++k) {
     const double x = 2 * pi * k / n;
-    const double phi = (2 * pi * m - holonomy) * k / n + c1 * std::sin(x + p1) + c2 * std::sin(2 * x + p2) +
-                       c3 * std::sin(3 * x + p3);
+    const double phi = (2 * pi * m - holonomy) * k / n + c1 * std::sin(x + p1) +
+                       c2 * std::sin(2 * x + p2) + c3 * std::sin(3 * x + p3);
     const Vec3 d = std::cos(phi) * P[k] + std::sin(phi) * T[k].cross(P[k]);
     d1[k] = (1.0 + 0.3 * std::cos(x + p2)) * (d + 0.2 * std::sin(2 * x + p3) * T[k]);
   }
@@ -123,7 +126,8 @@ TEST(Twist, TwistPlusWritheIsTheRibbonsLinkingNumber) {
     std::mt19937_64 rng(100 + seed);
     const auto X = random_fourier_curve(rng, 3).sample(n);
     const double eps = 1e-3 * mean_spacing(X);
-    ASSERT_GT(closest_approach(X, 10), 100 * eps) << "seed " << seed << ": curve nearly touches itself";
+    ASSERT_GT(closest_approach(X, 10), 100 * eps)
+        << "seed " << seed << ": curve nearly touches itself";
     const double wr = writhe(X);
     double lk0 = 0, tw0 = 0;
     for (int m : {0, -2, 1, 3}) {
@@ -146,7 +150,8 @@ TEST(Twist, TwistPlusWritheIsTheRibbonsLinkingNumber) {
       }
     }
   }
-  std::printf("ribbons: max |Lk − round(Lk)| = %.1e, max |Tw + Wr − Lk| = %.1e\n", worst_int, worst_sum);
+  std::printf("ribbons: max |Lk − round(Lk)| = %.1e, max |Tw + Wr − Lk| = %.1e\n", worst_int,
+              worst_sum);
 }
 
 TEST(Twist, SizeMismatchThrows) {

@@ -60,7 +60,8 @@ TEST(RelaxationTime, RecoversTauBehindAFasterMode) {
   const auto t = linspace(0, 8, 801);
   std::vector<double> E(t.size());
   for (size_t i = 0; i < t.size(); ++i)
-    E[i] = (1 - std::exp(-t[i] / 0.01)) * (std::exp(-2 * t[i] / tau) + 30 * std::exp(-2 * t[i] / tau_f));
+    E[i] = (1 - std::exp(-t[i] / 0.01)) *
+           (std::exp(-2 * t[i] / tau) + 30 * std::exp(-2 * t[i] / tau_f));
   const auto fit = relaxation_time(t, E);
   ASSERT_TRUE(fit);
   std::printf("tau = %.6f (exact %.6f), window from t = %.3f, R2 = %.8f\n", fit->tau, tau,

@@ -21,7 +21,8 @@ constexpr double pi = std::numbers::pi;
 /// The closed polygon through `P` resampled at n points evenly spaced in arc length.
 std::vector<Vec3> resample(const std::vector<Vec3>& P, int n) {
   std::vector<double> s{0};
-  for (std::size_t k = 0; k < P.size(); ++k) s.push_back(s.back() + (P[(k + 1) % P.size()] - P[k]).norm());
+  for (std::size_t k = 0; k < P.size(); ++k)
+    s.push_back(s.back() + (P[(k + 1) % P.size()] - P[k]).norm());
   std::vector<Vec3> X;
   std::size_t k = 0;
   for (int m = 0; m < n; ++m) {
@@ -66,7 +67,7 @@ std::vector<Vec3> interwound(int n, double rho, double rc, double Z, double half
     P.emplace_back(rc * std::cos(phi), 0, Z + zc + rc * std::sin(phi));
   }
   for (int k = 0; k < m; ++k) P.emplace_back(-rho, 0, Z - 2 * Z * k / m);  // down
-  for (int k = 0; k < m; ++k) {  // bottom loop
+  for (int k = 0; k < m; ++k) {                                            // bottom loop
     const double phi = phi0 + (pi - 2 * phi0) * k / m;
     P.emplace_back(-rc * std::cos(phi), 0, -Z - zc - rc * std::sin(phi));
   }

@@ -77,8 +77,8 @@ TEST(Writhe, PlanarCurvesHaveZeroWrithe) {
   }
   const double wr_star = writhe(transformed(S, R, shift, 10.0));
   EXPECT_LT(std::abs(wr_star), 1e-12);  // measured 1.3e-14 (K&L 1b's asin form: 1.4e-7)
-  std::printf("planar: Wr(circle) = %.1e, Wr(star) = %.1e; K&L 1b on the star: %.1e\n",
-              writhe(C), wr_star, writhe_kl1b(transformed(S, R, shift, 10.0)));
+  std::printf("planar: Wr(circle) = %.1e, Wr(star) = %.1e; K&L 1b on the star: %.1e\n", writhe(C),
+              wr_star, writhe_kl1b(transformed(S, R, shift, 10.0)));
 }
 
 TEST(Writhe, MatchesKleninLangowskiOnRandomCurves) {
@@ -119,7 +119,8 @@ TEST(Writhe, ImproperSymmetryForcesZero) {
   std::vector<Vec3> X(400);
   for (int k = 0; k < 400; ++k) {
     const double t = 2 * pi * k / 400;
-    X[k] = Vec3(std::cos(t) + a * std::cos(3 * t), std::sin(t) - a * std::sin(3 * t), b * std::sin(2 * t));
+    X[k] = Vec3(std::cos(t) + a * std::cos(3 * t), std::sin(t) - a * std::sin(3 * t),
+                b * std::sin(2 * t));
   }
   EXPECT_LT(std::abs(writhe(X)), 1e-12);
   // break the symmetry slightly: no longer zero (the check can fail)
@@ -131,10 +132,12 @@ TEST(Writhe, ImproperSymmetryForcesZero) {
 SmoothCurve trefoil() {
   SmoothCurve C;
   C.r = [](double t) {
-    return Vec3((2 + std::cos(3 * t)) * std::cos(2 * t), (2 + std::cos(3 * t)) * std::sin(2 * t), std::sin(3 * t));
+    return Vec3((2 + std::cos(3 * t)) * std::cos(2 * t), (2 + std::cos(3 * t)) * std::sin(2 * t),
+                std::sin(3 * t));
   };
   C.dr = [](double t) {
-    const double c3 = std::cos(3 * t), s3 = std::sin(3 * t), c2 = std::cos(2 * t), s2 = std::sin(2 * t);
+    const double c3 = std::cos(3 * t), s3 = std::sin(3 * t), c2 = std::cos(2 * t),
+                 s2 = std::sin(2 * t);
     return Vec3(-3 * s3 * c2 - 2 * (2 + c3) * s2, -3 * s3 * s2 + 2 * (2 + c3) * c2, 3 * c3);
   };
   return C;
@@ -149,8 +152,10 @@ TEST(Writhe, ConvergesToTheGaussIntegralOfTheSmoothCurve) {
   const double wr_smooth = (4 * q2 - q1) / 3;
   const double e1 = std::abs(writhe(C.sample(300)) - wr_smooth);
   const double e2 = std::abs(writhe(C.sample(600)) - wr_smooth);
-  std::printf("trefoil: Wr(smooth) ≈ %.9f (quadrature N=2400: %.9f); polygon error n=300: %.2e, "
-              "n=600: %.2e, ratio %.2f\n", wr_smooth, q2, e1, e2, e1 / e2);
+  std::printf(
+      "trefoil: Wr(smooth) ≈ %.9f (quadrature N=2400: %.9f); polygon error n=300: %.2e, "
+      "n=600: %.2e, ratio %.2f\n",
+      wr_smooth, q2, e1, e2, e1 / e2);
   EXPECT_GT(std::abs(wr_smooth), 2.0);
   EXPECT_LT(e2, 3e-4);             // measured 1.7e-4 (the quadrature's own error: ~6e-7)
   EXPECT_NEAR(e1 / e2, 4.0, 0.3);  // second order; measured 4.00

@@ -40,7 +40,7 @@ TEST(Progress, PlainLinesAreThrottledToOnePerIntervalPlusFirstAndLast) {
   out.f = nullptr;
   std::string s(out.buf, out.size);
   const auto lines = std::count(s.begin(), s.end(), '\n');
-  EXPECT_GE(lines, 7);   // first, at ~10, 20, 30, 40, 50 s, last
+  EXPECT_GE(lines, 7);  // first, at ~10, 20, 30, 40, 50 s, last
   EXPECT_LE(lines, 8);
   EXPECT_EQ(s.rfind("line 0\n", 0), 0u);
   EXPECT_THAT(s, HasSubstr("last\n"));

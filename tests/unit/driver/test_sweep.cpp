@@ -1,5 +1,5 @@
-// Sweep files (driver/sweep_file.hpp): the product of lists, stable point names, base configs, and every
-// kind of bad sweep file is a ConfigError naming the key.
+// Sweep files (driver/sweep_file.hpp): the product of lists, stable point names, base configs, and
+// every kind of bad sweep file is a ConfigError naming the key.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -39,7 +39,7 @@ TEST(Sweep, IsTheProductWithTheFirstKeySlowestAndStableNames) {
                         "[sweep]\n\"rod.excess_link\" = [1, 2, 3]\nsolvent.salt_M = [0.01, 0.1]\n");
   ASSERT_EQ(sw.axes.size(), 2u);
   ASSERT_EQ(sw.points.size(), 6u);
-  const char* names[] = {"dlk=1_salt_M=0.01", "dlk=1_salt_M=0.1", "dlk=2_salt_M=0.01",
+  const char* names[] = {"dlk=1_salt_M=0.01", "dlk=1_salt_M=0.1",  "dlk=2_salt_M=0.01",
                          "dlk=2_salt_M=0.1",  "dlk=3_salt_M=0.01", "dlk=3_salt_M=0.1"};
   for (int i = 0; i < 6; ++i) {
     EXPECT_EQ(sw.points[i].name, names[i]);
@@ -50,10 +50,12 @@ TEST(Sweep, IsTheProductWithTheFirstKeySlowestAndStableNames) {
   EXPECT_EQ(sw.points[3].config.grid_n, 16);  // the file's own sections are the base
   // the same file gives the same names (stable across runs); points.csv lists them
   EXPECT_EQ(parse(std::string(kTiny) + "[sweep]\n\"rod.excess_link\" = [1, 2, 3]\n"
-                                       "solvent.salt_M = [0.01, 0.1]\n").points[5].name,
+                                       "solvent.salt_M = [0.01, 0.1]\n")
+                .points[5]
+                .name,
             "dlk=3_salt_M=0.1");
   EXPECT_THAT(driver::points_csv(sw), HasSubstr("index,name,rod.excess_link,solvent.salt_M\n"
-                                            "0,dlk=1_salt_M=0.01,1,0.01\n"));
+                                                "0,dlk=1_salt_M=0.01,1,0.01\n"));
 }
 
 TEST(Sweep, NamesAreSanitisedShortenedAndRenamable) {
@@ -78,9 +80,10 @@ TEST(Sweep, ABaseFileIsReadRelativeToTheSweepFileAndOverridden) {
   const fs::path dir = fs::temp_directory_path() / "ibrod_test_sweep_base";
   fs::create_directories(dir);
   std::ofstream(dir / "base.toml") << kTiny << "[solvent]\nsalt_M = 0.05\n";
-  const auto sw = parse("base = \"base.toml\"\n[time]\nt_end_us = 0.03\n"
-                        "[sweep]\nrod.excess_link = [4]\n",
-                        dir);
+  const auto sw = parse(
+      "base = \"base.toml\"\n[time]\nt_end_us = 0.03\n"
+      "[sweep]\nrod.excess_link = [4]\n",
+      dir);
   ASSERT_EQ(sw.points.size(), 1u);
   EXPECT_EQ(sw.points[0].config.solvent_salt_M, 0.05);
   EXPECT_EQ(sw.points[0].config.time_t_end_us, 0.03);
@@ -102,8 +105,7 @@ TEST(Sweep, BadSweepFilesAreRejectedNamingTheKey) {
               HasSubstr("[sweep] solvent.salt_M = -1.0"));
   EXPECT_THAT(error_of(t + "[sweep]\nsolvent.salt_M = [0.1, -1.0]\n"),
               HasSubstr("is invalid: expected a number >= 0"));
-  EXPECT_THAT(error_of(t + "[sweep]\nrod.excess_link = [1, 1]\n"),
-              HasSubstr("same name 'dlk=1'"));
+  EXPECT_THAT(error_of(t + "[sweep]\nrod.excess_link = [1, 1]\n"), HasSubstr("same name 'dlk=1'"));
   EXPECT_THAT(error_of(t), HasSubstr("no [sweep] table"));
   EXPECT_THAT(error_of("jobs = 3\n" + t + "[sweep]\nrod.excess_link = [1]\n"),
               HasSubstr("unknown top-level key 'jobs'"));
@@ -140,14 +142,16 @@ TEST(Sweep, PointStatesFollowTheRunFiles) {
 }
 
 TEST(Sweep, TheReferenceExampleIsTheEighteenReferenceRuns) {
-  const auto sw = driver::load_sweep(fs::path(IBROD_SOURCE_DIR) / "examples" / "sweep_reference.toml");
+  const auto sw =
+      driver::load_sweep(fs::path(IBROD_SOURCE_DIR) / "examples" / "sweep_reference.toml");
   ASSERT_EQ(sw.points.size(), 18u);
   // each point's config equals examples/reference/dlkN_csC.toml
   for (const auto& pt : sw.points) {
     char name[64];
     std::snprintf(name, sizeof name, "dlk%d_cs%g.toml", pt.config.rod_excess_link,
                   pt.config.solvent_salt_M);
-    const auto ref = config::load_config((fs::path(IBROD_SOURCE_DIR) / "examples" / "reference" / name).string());
+    const auto ref = config::load_config(
+        (fs::path(IBROD_SOURCE_DIR) / "examples" / "reference" / name).string());
     EXPECT_EQ(config::to_toml(pt.config), config::to_toml(ref)) << pt.name;
   }
 }

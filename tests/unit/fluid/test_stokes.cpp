@@ -53,8 +53,7 @@ TEST(Stokes, ShearModeHasTheClosedFormAmplitude) {
   const double A = 3e-7;
   for (int i = 0; i < g.n; ++i)
     for (int j = 0; j < g.n; ++j)
-      for (int k = 0; k < g.n; ++k)
-        f[1][g.index(i, j, k)] = A * std::sin(2 * kPi * m * i / g.n);
+      for (int k = 0; k < g.n; ++k) f[1][g.index(i, j, k)] = A * std::sin(2 * kPi * m * i / g.n);
   fl.solve_stokes(ArrayForcing(g, f));
   const double s = std::sin(kPi * m / g.n);
   const double denom = params().viscosity * 4 / (g.h() * g.h()) * s * s;
@@ -82,8 +81,9 @@ TEST(Stokes, GradientForceMakesNoFlowAndTheMeanIsDropped) {
     for (int j = 0; j < g.n; ++j)
       for (int k = 0; k < g.n; ++k) {
         // φ = cos(2π 3 j/n): D_h φ along y, central difference
-        const double d = (std::cos(2 * kPi * 3 * (j + 1) / g.n) - std::cos(2 * kPi * 3 * (j - 1) / g.n)) /
-                         (2 * g.h());
+        const double d =
+            (std::cos(2 * kPi * 3 * (j + 1) / g.n) - std::cos(2 * kPi * 3 * (j - 1) / g.n)) /
+            (2 * g.h());
         f[1][g.index(i, j, k)] = 1e-6 * d + 2e-7;
         f[0][g.index(i, j, k)] = -5e-7;
       }
@@ -114,11 +114,12 @@ TEST(Stokes, RandomForceGivesADivergenceFreeZeroMeanLinearResponse) {
     return u;
   };
   const auto u1 = solve(f1), u2 = solve(f2), u12 = solve(f12);
-  EXPECT_LT(fl.max_divergence() * g.h(), 1e-10 * [&] {
-    double m = 0;
-    for (double v : u12[0]) m = std::max(m, std::abs(v));
-    return m;
-  }());
+  EXPECT_LT(
+      fl.max_divergence() * g.h(), 1e-10 * [&] {
+        double m = 0;
+        for (double v : u12[0]) m = std::max(m, std::abs(v));
+        return m;
+      }());
   double lin = 0, umax = 0;
   for (int c = 0; c < 3; ++c) {
     double mean = 0;

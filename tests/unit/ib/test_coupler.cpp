@@ -46,10 +46,12 @@ Vec3 random_vec(std::mt19937_64& rng, double lo, double hi) {
 // grid nodes, where the index arithmetic is most fragile.
 std::vector<Vec3> test_points(std::mt19937_64& rng, const GridSpec& g, int nrandom) {
   const double L = g.L, h = g.h();
-  std::vector<Vec3> X = {
-      {0.0, 0.0, 0.0},           {-1e-13, L - 1e-12, 0.5 * h}, {L, -L, 2 * L},
-      {L - 0.01 * h, 0.01 * h, -0.01 * h}, {3 * h, 5 * h - 1e-9, -7 * h},
-      {-2 * L + 0.3 * h, 3 * L - 0.2 * h, 0.999999 * L}};
+  std::vector<Vec3> X = {{0.0, 0.0, 0.0},
+                         {-1e-13, L - 1e-12, 0.5 * h},
+                         {L, -L, 2 * L},
+                         {L - 0.01 * h, 0.01 * h, -0.01 * h},
+                         {3 * h, 5 * h - 1e-9, -7 * h},
+                         {-2 * L + 0.3 * h, 3 * L - 0.2 * h, 0.999999 * L}};
   for (int t = 0; t < nrandom; ++t) X.push_back(random_vec(rng, -2 * L, 3 * L));
   return X;
 }
@@ -141,7 +143,7 @@ TEST(Coupler, RejectsBadKernelWidthAndGrid) {
   EXPECT_THROW(Coupler(make_grid(16), -1), std::invalid_argument);
   EXPECT_THROW(Coupler(make_grid(64), Coupler::kMaxKernelWidth + 1), std::invalid_argument);
   EXPECT_THROW(Coupler(make_grid(16), 4), std::invalid_argument);  // 4m + 2 = 18 > 16
-  EXPECT_NO_THROW(Coupler(make_grid(14), 3));                       // 4m + 2 = 14 = n
+  EXPECT_NO_THROW(Coupler(make_grid(14), 3));                      // 4m + 2 = 14 = n
   EXPECT_THROW(Coupler(GridSpec{16, 0.0}, 1), std::invalid_argument);
   const Coupler c(make_grid(32), 2);
   EXPECT_EQ(c.stencil(), 10);
@@ -157,10 +159,8 @@ TEST(Coupler, RejectsMismatchedSizesAndBadPositions) {
   F.resize(3);
   const std::span<const Vec3> two_torques = std::span<const Vec3>(F).first(2);
   EXPECT_THROW(cp.spread(X, F, two_torques, f.ptr()), std::invalid_argument);
-  EXPECT_THROW(cp.interpolate(X, f.cptr(), std::span<Vec3>(U).first(2), {}),
-               std::invalid_argument);
-  EXPECT_THROW(cp.interpolate(X, f.cptr(), U, std::span<Vec3>(U).first(1)),
-               std::invalid_argument);
+  EXPECT_THROW(cp.interpolate(X, f.cptr(), std::span<Vec3>(U).first(2), {}), std::invalid_argument);
+  EXPECT_THROW(cp.interpolate(X, f.cptr(), U, std::span<Vec3>(U).first(1)), std::invalid_argument);
   X[1][2] = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(cp.spread(X, F, {}, f.ptr()), RunError);
   EXPECT_THROW(cp.interpolate(X, f.cptr(), U, {}), RunError);
@@ -223,8 +223,8 @@ TEST(Coupler, SpreadAndInterpolateAreAdjoint) {
         const char* name;
         bool force, torque;
       };
-      for (const Case cs : {Case{"forces", true, false}, Case{"torques", false, true},
-                            Case{"both", true, true}}) {
+      for (const Case cs :
+           {Case{"forces", true, false}, Case{"torques", false, true}, Case{"both", true, true}}) {
         Field f(g);
         const std::span<const Vec3> torques =
             cs.torque ? std::span<const Vec3>(T) : std::span<const Vec3>();
@@ -373,8 +373,7 @@ TEST(Coupler, PeriodicImagesSpreadIdentically) {
     cp.spread(std::vector<Vec3>{X}, std::vector<Vec3>{F}, std::vector<Vec3>{T}, f0.ptr());
     for (const Vec3& shift : {Vec3(g.L, 0, 0), Vec3(0, -2 * g.L, 0), Vec3(3 * g.L, g.L, -g.L)}) {
       Field f1(g);
-      cp.spread(std::vector<Vec3>{X + shift}, std::vector<Vec3>{F}, std::vector<Vec3>{T},
-                f1.ptr());
+      cp.spread(std::vector<Vec3>{X + shift}, std::vector<Vec3>{F}, std::vector<Vec3>{T}, f1.ptr());
       double err = 0;
       for (int x = 0; x < 3; ++x)
         for (std::size_t id = 0; id < g.size(); ++id)
@@ -396,15 +395,14 @@ TEST(Coupler, ParallelSpreadIsRaceFreeAndDeterministic) {
     std::vector<Vec3> X, F, T;
     for (int p = 0; p < 200; ++p) {
       // half in a small cluster straddling the x seam, half anywhere
-      X.push_back(p % 2 ? random_vec(rng, -2 * g.h(), 2 * g.h())
-                        : random_vec(rng, -g.L, 2 * g.L));
+      X.push_back(p % 2 ? random_vec(rng, -2 * g.h(), 2 * g.h()) : random_vec(rng, -g.L, 2 * g.L));
       F.push_back(random_vec(rng, -1, 1));
       T.push_back(random_vec(rng, -10, 10));
     }
     Field serial(g);
     for (std::size_t p = 0; p < X.size(); ++p)
-      cp.spread(std::span(X).subspan(p, 1), std::span(F).subspan(p, 1),
-                std::span(T).subspan(p, 1), serial.ptr());
+      cp.spread(std::span(X).subspan(p, 1), std::span(F).subspan(p, 1), std::span(T).subspan(p, 1),
+                serial.ptr());
     const int saved = omp_get_max_threads();
     Field first(g);
     // A race shows only sometimes, so each thread count is repeated (an injected race, all slabs

@@ -52,8 +52,7 @@ TEST(Phi4, SumRules) {
 TEST(Delta, SeparableAndScaled) {
   const double c = 2 * kH;
   const Vec3 x(3.0, -17.5, 9.25);
-  EXPECT_DOUBLE_EQ(delta(x, c),
-                   phi4(x[0] / c) * phi4(x[1] / c) * phi4(x[2] / c) / (c * c * c));
+  EXPECT_DOUBLE_EQ(delta(x, c), phi4(x[0] / c) * phi4(x[1] / c) * phi4(x[2] / c) / (c * c * c));
   EXPECT_EQ(delta(Vec3(2 * c, 0, 0), c), 0.0);
   // peak value φ(0)³/c³, Å⁻³
   EXPECT_DOUBLE_EQ(delta(Vec3::Zero(), c), 0.125 / (c * c * c));

@@ -43,8 +43,8 @@ std::vector<Vec3> points(std::mt19937_64& rng, const GridSpec& g, int m, int nra
   std::uniform_real_distribution<double> uni(-L, 2 * L);
   std::vector<Vec3> X = {{0.0, 0.0, 0.0}, {L - 0.3 * h, 0.2 * h, L - 1e-9}, {-0.5 * h, L, 0.5 * h}};
   // first z index z0 = ⌊z/h⌋ − 2m: z0 + S = n, n − 1, n + 1 and z0 + 8 = n ± 1
-  for (int z0 : {g.n - (4 * m + 2), g.n - (4 * m + 2) + 1, g.n - (4 * m + 2) - 1, g.n - 8,
-                 g.n - 9, g.n - 7})
+  for (int z0 :
+       {g.n - (4 * m + 2), g.n - (4 * m + 2) + 1, g.n - (4 * m + 2) - 1, g.n - 8, g.n - 9, g.n - 7})
     X.push_back({0.37 * L, 0.61 * L, (z0 + 2 * m + 0.4) * h});
   for (int t = 0; t < nrandom; ++t) X.push_back({uni(rng), uni(rng), uni(rng)});
   return X;
@@ -77,7 +77,8 @@ TEST_P(PlaneCouplerTest, SpreadingPlaneByPlaneEqualsWholeGridSpreading) {
 
   double diff = 0;
   for (int c = 0; c < 3; ++c)
-    for (std::size_t q = 0; q < g.size(); ++q) diff = std::max(diff, std::abs(got[c][q] - ref[c][q]));
+    for (std::size_t q = 0; q < g.size(); ++q)
+      diff = std::max(diff, std::abs(got[c][q] - ref[c][q]));
   EXPECT_GT(max_abs(ref), 0.0);
   EXPECT_LE(diff, 1e-13 * max_abs(ref)) << "n = " << n << ", m = " << m;
 }

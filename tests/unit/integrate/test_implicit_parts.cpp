@@ -7,8 +7,8 @@
 #include <cmath>
 #include <random>
 
-#include "integrate/implicit.hpp"
 #include "config/config.hpp"
+#include "integrate/implicit.hpp"
 
 namespace ibrod::integrate {
 namespace {

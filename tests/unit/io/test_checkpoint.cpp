@@ -23,8 +23,8 @@ namespace fs = std::filesystem;
 namespace {
 
 fs::path scratch(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() /
-                     ("ibrod_ckpt_" + name + "_" + std::to_string(::getpid()));
+  const fs::path d =
+      fs::temp_directory_path() / ("ibrod_ckpt_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(d);
   fs::create_directories(d);
   return d;
@@ -146,7 +146,8 @@ TEST(Checkpoint, EveryFlippedPayloadBitIsCaught) {
 
 TEST(Checkpoint, ForeignFilesAndOtherVersionsAreRejected) {
   const fs::path d = scratch("foreign");
-  std::ofstream(d / "x.bin") << "[grid]\nn = 16\n# not a checkpoint, but long enough for a header\n";
+  std::ofstream(d / "x.bin")
+      << "[grid]\nn = 16\n# not a checkpoint, but long enough for a header\n";
   EXPECT_THAT(read_error(d / "x.bin"), HasSubstr("not an ibrod checkpoint"));
   EXPECT_THAT(read_error(d / "missing.bin"), HasSubstr("cannot be read"));
 

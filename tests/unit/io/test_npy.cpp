@@ -23,7 +23,8 @@ std::vector<double> read_velocity_npy(const std::filesystem::path& path, int& n)
   char pre[10];
   if (!in.read(pre, 10) || std::memcmp(pre, "\x93NUMPY", 6) != 0)
     throw std::runtime_error("npy: " + path.string() + " is not a .npy file");
-  const std::size_t hlen = std::size_t(std::uint8_t(pre[8])) | std::size_t(std::uint8_t(pre[9])) << 8;
+  const std::size_t hlen = std::size_t(std::uint8_t(pre[8])) | std::size_t(std::uint8_t(pre[9]))
+                                                                   << 8;
   std::string dict(hlen, '\0');
   in.read(dict.data(), std::streamsize(hlen));
   const auto s = dict.find("'shape': (3, ");

@@ -6,9 +6,9 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -61,7 +61,8 @@ TEST(Vtk, RodPolylineCarriesTriadsTwistAndStretch) {
   const double ds = 3.4, tau = 0.05;
   const rod::RodState s = twisted_line(n, ds, 1.1, tau);
   const std::string xml = io::rod_vtp(s, ds);
-  EXPECT_THAT(xml, HasSubstr("<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\""));
+  EXPECT_THAT(xml,
+              HasSubstr("<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\""));
   EXPECT_THAT(xml, HasSubstr("NumberOfPoints=\"12\""));
   EXPECT_THAT(xml, HasSubstr("NumberOfLines=\"1\""));
   EXPECT_EQ(data_array(xml, "Points").size(), 3u * n);

@@ -81,7 +81,8 @@ TEST(Render, BackgroundInsideTheRingRodOnIt) {
     const double a = 2 * kPi * (q + 0.5) / 8;
     const Rgb p = img.at(m.px(r0 * std::cos(a)), m.py(r0 * std::sin(a)));
     EXPECT_FALSE(is_background(p)) << "angle " << a;
-    EXPECT_TRUE(is_stripe(p)) << "angle " << a << ": " << int(p.r) << "," << int(p.g) << "," << int(p.b);
+    EXPECT_TRUE(is_stripe(p)) << "angle " << a << ": " << int(p.r) << "," << int(p.g) << ","
+                              << int(p.b);
   }
   // near the inner and outer rims the normal is ⟂ to D¹: tube colour
   const Rgb rim = img.at(m.px(r0 + 0.8 * D / 2), h / 2);
@@ -158,8 +159,10 @@ TEST(Render, TwistWindsTheStripeAroundTheTube) {
 TEST(Render, BadInputThrows) {
   const Ring ring(50, 10.0);
   const std::vector<Vec3> short_d1(ring.d1.begin(), ring.d1.begin() + 10);
-  EXPECT_THROW(render_rod(ring.X, short_d1, 2.0, standard_view("top"), 10, 10), std::invalid_argument);
-  EXPECT_THROW(render_rod(ring.X, ring.d1, 2.0, standard_view("top"), 0, 10), std::invalid_argument);
+  EXPECT_THROW(render_rod(ring.X, short_d1, 2.0, standard_view("top"), 10, 10),
+               std::invalid_argument);
+  EXPECT_THROW(render_rod(ring.X, ring.d1, 2.0, standard_view("top"), 0, 10),
+               std::invalid_argument);
   EXPECT_THROW(standard_view("diagonal"), std::invalid_argument);
   View v{"bad", {0, 0, 1}, {0, 0, 2}};
   EXPECT_THROW(render_rod(ring.X, ring.d1, 2.0, v, 10, 10), std::invalid_argument);
