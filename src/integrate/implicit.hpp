@@ -201,4 +201,11 @@ class ImplicitIntegrator {
   int rejected_ = 0;
 };
 
+namespace detail {
+/// The steric contacts' stiffness −∂F_steric/∂X as triplets of the 6n × 6n system (implicit_
+/// stiffness.cpp); trip = nullptr: count the contacts only. Returns the number of contacts.
+int add_steric_stiffness(const interactions::StericParams& p, std::span<const Vec3> X,
+                         std::vector<Eigen::Triplet<double>>* trip);
+}  // namespace detail
+
 }  // namespace ibrod::integrate

@@ -1,0 +1,339 @@
+// The local half of the implicit step (implicit.hpp): the Gauss–Newton elastic stiffness K and
+// the steric contacts' stiffness, and the factorisation and solve of M_loc⁻¹ + Δt K.
+#include "integrate/implicit.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+
+#include "core/error.hpp"
+
+namespace ibrod::integrate {
+
+namespace {
+
+using Eigen::VectorXd;
+
+// Colours of a closed rod of n points such that two points of one colour are at least 3 apart
+// along the rod (cyclically): perturbing all of them at once changes each F_k, T_k through one
+// of them at most. Greedy: ≤ 5 colours, 3 when n is a multiple of 3.
+std::vector<int> colouring(int n) {
+  std::vector<int> c(n, -1);
+  for (int k = 0; k < n; ++k) {
+    bool used[8] = {};
+    for (int o = -2; o <= 2; ++o) {
+      const int j = ((k + o) % n + n) % n;
+      if (o != 0 && c[j] >= 0) used[c[j]] = true;
+    }
+    int col = 0;
+    while (used[col]) ++col;
+    c[k] = col;
+  }
+  return c;
+}
+
+}  // namespace
+
+namespace detail {
+
+// The steric contacts' stiffness −∂F_steric/∂X, added to K as triplets: for each pair of
+// segments in contact (closest points P(s), Q(t) at d < D along u), the linearisation of
+// g (D − d) u with s, t and u frozen, g w wᵀ ⊗ u uᵀ, w = (1 − s, s, −(1 − t), −t) over the
+// end points (X_k, X_{k+1}, X_l, X_{l+1}): positive semi-definite. (The transverse term
+// −g (D − d)/d (I − u uᵀ), small at small overlap and destabilising, is left out.) Candidate
+// segment pairs from a cell grid over the midpoints; trip = nullptr: count the contacts only.
+int add_steric_stiffness(const interactions::StericParams& p, std::span<const Vec3> X,
+                         std::vector<Eigen::Triplet<double>>* trip) {
+  const int n = int(X.size());
+  if (!p.enabled || n < 4 || !(p.diameter > 0) || !(p.stiffness > 0)) return 0;
+  std::vector<Vec3> mid(n);
+  double lmax2 = 0;
+  for (int k = 0; k < n; ++k) {
+    mid[k] = 0.5 * (X[k] + X[(k + 1) % n]);
+    lmax2 = std::max(lmax2, (X[(k + 1) % n] - X[k]).squaredNorm());
+  }
+  const double reach = p.diameter + std::sqrt(lmax2);
+  // candidates from a grid of cells of edge `reach` over the midpoints (sorted by cell key):
+  // for each k, the partners l > k in the 27 cells around it, in ascending order
+  auto cell = [&](const Vec3& x, int d) { return std::int64_t(std::floor(x[d] / reach)); };
+  auto key = [](std::int64_t i, std::int64_t j, std::int64_t k) {
+    return ((i & 0x1FFFFF) << 42) | ((j & 0x1FFFFF) << 21) | (k & 0x1FFFFF);
+  };
+  std::vector<std::pair<std::int64_t, int>> sorted(n);
+  for (int k = 0; k < n; ++k)
+    sorted[k] = {key(cell(mid[k], 0), cell(mid[k], 1), cell(mid[k], 2)), k};
+  std::sort(sorted.begin(), sorted.end());
+  int contacts = 0;
+  std::vector<int> partners;
+  for (int k = 0; k < n; ++k) {
+    partners.clear();
+    const std::int64_t ci = cell(mid[k], 0), cj = cell(mid[k], 1), ck = cell(mid[k], 2);
+    for (std::int64_t di = -1; di <= 1; ++di)
+      for (std::int64_t dj = -1; dj <= 1; ++dj)
+        for (std::int64_t dk = -1; dk <= 1; ++dk) {
+          const std::int64_t q = key(ci + di, cj + dj, ck + dk);
+          auto it = std::lower_bound(sorted.begin(), sorted.end(), std::make_pair(q, -1));
+          for (; it != sorted.end() && it->first == q; ++it) {
+            const int l = it->second, m = l - k;
+            // more than 2D apart along the rod (MODEL (2.17)), as Steric
+            if (l > k && std::min(m, n - m) * p.ds > 2 * p.diameter) partners.push_back(l);
+          }
+        }
+    std::sort(partners.begin(), partners.end());
+    for (const int l : partners) {
+      if ((mid[k] - mid[l]).squaredNorm() >= reach * reach) continue;
+      const int k1 = (k + 1) % n, l1 = (l + 1) % n;
+      const auto c = interactions::closest_points(X[k], X[k1], X[l], X[l1]);
+      if (!(c.d < p.diameter) || !(c.d > 0)) continue;
+      ++contacts;
+      if (!trip) continue;
+      const Vec3 u = c.sep / c.d;
+      const Mat3 uu = p.stiffness * u * u.transpose();
+      const int idx[4] = {k, k1, l, l1};
+      const double w[4] = {1 - c.s, c.s, -(1 - c.t), -c.t};
+      for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b)
+          for (int r = 0; r < 3; ++r)
+            for (int q = 0; q < 3; ++q)
+              trip->emplace_back(6 * idx[a] + r, 6 * idx[b] + q, w[a] * w[b] * uu(r, q));
+    }
+  }
+  return contacts;
+}
+
+}  // namespace detail
+
+void ImplicitStepper::gn_blocks(const rod::RodState& s) {
+  // Gauss–Newton with the small-strain strain Jacobian of half point h (between k and k+1,
+  // triad D_h = [D¹ D² D³], X′ = (X_{k+1} − X_k)/Δs), MODEL §4 step 2 linearised:
+  //   δΓ_i = D^i·(δX_{k+1} − δX_k)/Δs + ½ (D^i × X′)·(δθ_k + δθ_{k+1})
+  //   δΩ_i = D^i·(δθ_{k+1} − δθ_k)/Δs
+  // (a common rotation leaves Γ unchanged; the half-point triad turns by the mean of its two
+  // ends'). K = Δs Σ_h J_hᵀ C J_h, C = diag(b1, b2, b3, a1, a2, a3): symmetric positive
+  // semi-definite, O(n), block-cyclic-tridiagonal: Kd_[k] = K[k][k], Ko_[k] = K[k+1][k].
+  // tests/unit/integrate/test_implicit_parts.cpp compares it with the finite-difference K.
+  const int n = s.size();
+  const rod::RodParams& rp = st_.params().rod;
+  using Mat6 = Eigen::Matrix<double, 6, 6>;
+  Kd_.assign(n, Mat6::Zero());
+  Ko_.assign(n, Mat6::Zero());
+  Eigen::Matrix<double, 6, 1> c;
+  c << rp.b.x(), rp.b.y(), rp.b.z(), rp.a.x(), rp.a.y(), rp.a.z();
+  for (int h = 0; h < n; ++h) {
+    const int h1 = (h + 1) % n;
+    const Mat3 Dh = rod::half_point_triad(s.D[h], s.D[h1]);
+    const Vec3 xp = (s.X[h1] - s.X[h]) / rp.ds;
+    Mat3 G;  // rows (D^i × X′)ᵀ
+    for (int i = 0; i < 3; ++i) G.row(i) = Dh.col(i).cross(xp).transpose();
+    Mat6 JL = Mat6::Zero(), JR = Mat6::Zero();  // ∂(Γ, Ω)/∂q_h, ∂(Γ, Ω)/∂q_{h+1}
+    JL.block<3, 3>(0, 0) = -Dh.transpose() / rp.ds;
+    JR.block<3, 3>(0, 0) = Dh.transpose() / rp.ds;
+    JL.block<3, 3>(0, 3) = 0.5 * G;
+    JR.block<3, 3>(0, 3) = 0.5 * G;
+    JL.block<3, 3>(3, 3) = -Dh.transpose() / rp.ds;
+    JR.block<3, 3>(3, 3) = Dh.transpose() / rp.ds;
+    const Mat6 CL = rp.ds * c.asDiagonal() * JL, CR = rp.ds * c.asDiagonal() * JR;
+    Kd_[h].noalias() += JL.transpose() * CL;
+    Kd_[h1].noalias() += JR.transpose() * CR;
+    Ko_[h].noalias() = JR.transpose() * CL;  // K[h+1][h]
+  }
+}
+
+Eigen::SparseMatrix<double> ImplicitStepper::stiffness(const rod::RodState& s) {
+  const int n = s.size();
+  const rod::RodParams& rp = st_.params().rod;
+  if (p_.gauss_newton && !p_.stiffness_fd) {
+    gn_blocks(s);
+    std::vector<Eigen::Triplet<double>> trip;
+    trip.reserve(std::size_t(n) * 3 * 36 + 4096);
+    for (int h = 0; h < n; ++h) {
+      const int h1 = (h + 1) % n;
+      for (int r = 0; r < 6; ++r)
+        for (int q = 0; q < 6; ++q) {
+          trip.emplace_back(6 * h + r, 6 * h + q, Kd_[h](r, q));
+          trip.emplace_back(6 * h1 + r, 6 * h + q, Ko_[h](r, q));
+          trip.emplace_back(6 * h + r, 6 * h1 + q, Ko_[h](q, r));
+        }
+    }
+    contacts_ =
+        p_.steric_implicit ? detail::add_steric_stiffness(st_.params().steric, s.X, &trip) : 0;
+    Eigen::SparseMatrix<double> K(6 * n, 6 * n);
+    K.setFromTriplets(trip.begin(), trip.end());
+    K.makeCompressed();
+    return K;
+  }
+  const std::vector<int> col = colouring(n);
+  const int ncol = *std::max_element(col.begin(), col.end()) + 1;
+  pert_ = s;
+  std::vector<Eigen::Triplet<double>> trip;
+  trip.reserve(std::size_t(n) * 3 * 36 + 4096);
+  using Mat6 = Eigen::Matrix<double, 6, 6>;
+  using Vec6 = Eigen::Matrix<double, 6, 1>;
+  // Gauss–Newton: the stress resultants of half point h, σ_h = (D_hᵀF_h, D_hᵀN_h) = C (ε_h − ε₀),
+  // and their derivatives S_L = ∂σ_h/∂q_h, S_R = ∂σ_h/∂q_{h+1} by the same differences
+  std::vector<Mat6> SL, SR;
+  std::vector<Vec6> sp, sm;
+  if (p_.gauss_newton) {
+    SL.assign(n, Mat6::Zero());
+    SR.assign(n, Mat6::Zero());
+    sp.assign(n, Vec6::Zero());
+    sm.assign(n, Vec6::Zero());
+  }
+  auto sigma = [&](int h) {
+    Vec6 v;
+    v.head<3>() = work_.Dh[h].transpose() * work_.Fh[h];
+    v.tail<3>() = work_.Dh[h].transpose() * work_.Nh[h];
+    return v;
+  };
+  auto forces = [&](std::vector<Vec3>& F, std::vector<Vec3>& T, std::vector<Vec6>& sig, int c) {
+    std::fill(F.begin(), F.end(), Vec3::Zero());
+    std::fill(T.begin(), T.end(), Vec3::Zero());
+    rod::elastic_forces(rp, pert_, work_, F, T);
+    if (p_.gauss_newton)
+      for (int j = 0; j < n; ++j)
+        if (col[j] == c) {
+          const int jm = (j + n - 1) % n;
+          sig[j] = sigma(j);
+          sig[jm] = sigma(jm);
+        }
+  };
+  for (int c = 0; c < ncol; ++c) {
+    for (int d = 0; d < 6; ++d) {
+      const double eps = d < 3 ? p_.fd_dx : p_.fd_dtheta;
+      for (int side = 0; side < 2; ++side) {
+        const double e = side == 0 ? eps : -eps;
+        for (int j = 0; j < n; ++j) {
+          if (col[j] != c) continue;
+          if (d < 3)
+            pert_.X[j][d] = s.X[j][d] + e;
+          else
+            pert_.D[j] = rotation(e * Vec3::Unit(d - 3)) * s.D[j];
+        }
+        if (side == 0)
+          forces(Fa_, Ta_, sp, c);
+        else
+          forces(Fb_, Tb_, sm, c);
+      }
+      for (int j = 0; j < n; ++j) {
+        if (col[j] != c) continue;
+        pert_.X[j] = s.X[j];
+        pert_.D[j] = s.D[j];
+        if (p_.gauss_newton) {
+          const int jm = (j + n - 1) % n;
+          SL[j].col(d) = (sp[j] - sm[j]) / (2 * eps);
+          SR[jm].col(d) = (sp[jm] - sm[jm]) / (2 * eps);
+          continue;
+        }
+        for (int o = -1; o <= 1; ++o) {
+          const int i = ((j + o) % n + n) % n;
+          for (int r = 0; r < 3; ++r) {
+            trip.emplace_back(6 * i + r, 6 * j + d, -(Fa_[i][r] - Fb_[i][r]) / (2 * eps));
+            trip.emplace_back(6 * i + 3 + r, 6 * j + d, -(Ta_[i][r] - Tb_[i][r]) / (2 * eps));
+          }
+        }
+      }
+    }
+  }
+  if (p_.gauss_newton) {
+    // K = Δs Σ_h J_hᵀ C J_h = Δs Σ_h S_hᵀ C⁻¹ S_h over the points h, h+1 of each half point
+    Vec6 cinv;
+    cinv << 1 / rp.b.x(), 1 / rp.b.y(), 1 / rp.b.z(), 1 / rp.a.x(), 1 / rp.a.y(), 1 / rp.a.z();
+    for (int h = 0; h < n; ++h) {
+      const int h1 = (h + 1) % n;
+      const int idx[2] = {h, h1};
+      const Mat6* S[2] = {&SL[h], &SR[h]};
+      for (int a = 0; a < 2; ++a)
+        for (int b = 0; b < 2; ++b) {
+          const Mat6 blk = rp.ds * S[a]->transpose() * cinv.asDiagonal() * (*S[b]);
+          for (int r = 0; r < 6; ++r)
+            for (int q = 0; q < 6; ++q)
+              trip.emplace_back(6 * idx[a] + r, 6 * idx[b] + q, blk(r, q));
+        }
+    }
+  }
+  contacts_ =
+      p_.steric_implicit ? detail::add_steric_stiffness(st_.params().steric, s.X, &trip) : 0;
+  Eigen::SparseMatrix<double> K(6 * n, 6 * n);
+  K.setFromTriplets(trip.begin(), trip.end());
+  K.makeCompressed();
+  return K;
+}
+
+void ImplicitStepper::factorize(double dt) {
+  // M_loc = β diag(m_t I, m_r I)
+  mloc_.resize(6 * n_);
+  for (int k = 0; k < n_; ++k) {
+    mloc_.segment<3>(6 * k).setConstant(p_.mobility_scale * m_t_);
+    mloc_.segment<3>(6 * k + 3).setConstant(p_.mobility_scale * m_r_);
+  }
+  if (use_blocks_) {
+    std::vector<Eigen::Matrix<double, 6, 6>>& diag = sdiag_;
+    std::vector<Eigen::Matrix<double, 6, 6>>& lower = slower_;
+    diag.resize(n_);
+    lower.resize(n_);
+    for (int k = 0; k < n_; ++k) {
+      diag[k] = dt * Kd_[k];
+      for (int i = 0; i < 6; ++i) diag[k](i, i) += 1.0 / mloc_[6 * k + i];
+      lower[k] = dt * Ko_[k];
+    }
+    if (!bcc_.factorize(diag, lower))
+      throw std::runtime_error("ImplicitStepper: the local implicit system is not positive");
+    lu_dt_ = dt;
+    return;
+  }
+  const bool contacts_changed = contacts_ > 0 || pattern_contacts_ > 0;
+  if (p_.gauss_newton) {
+    // K symmetric positive semi-definite: I + Δt M_loc K = M_loc (M_loc⁻¹ + Δt K), and
+    // S = M_loc⁻¹ + Δt K is symmetric positive definite: sparse Cholesky (AMD ordering)
+    Eigen::SparseMatrix<double> S = dt * K_;
+    for (int i = 0; i < 6 * n_; ++i) S.coeffRef(i, i) += 1.0 / mloc_[i];
+    S.makeCompressed();
+    if (!pattern_ready_ || S.nonZeros() != pattern_nnz_ || contacts_changed) {
+      llt_.analyzePattern(S);
+      pattern_ready_ = true;
+      pattern_nnz_ = S.nonZeros();
+      pattern_contacts_ = contacts_;
+    }
+    llt_.factorize(S);
+    if (llt_.info() != Eigen::Success)
+      throw std::runtime_error("ImplicitStepper: the local implicit system is not positive");
+    lu_dt_ = dt;
+    return;
+  }
+  // velocity form: A = I + Δt M_loc K (row scaling); force form: I + Δt K M_loc (columns)
+  Eigen::SparseMatrix<double> A = p_.velocity_form
+                                      ? Eigen::SparseMatrix<double>(mloc_.asDiagonal() * K_)
+                                      : Eigen::SparseMatrix<double>(K_ * mloc_.asDiagonal());
+  A *= dt;
+  for (int i = 0; i < 6 * n_; ++i) A.coeffRef(i, i) += 1.0;
+  A.makeCompressed();
+  // the band along the rod is fixed; steric contacts add and remove entries
+  if (!pattern_ready_ || A.nonZeros() != pattern_nnz_ || contacts_changed) {
+    lu_.analyzePattern(A);
+    pattern_ready_ = true;
+    pattern_nnz_ = A.nonZeros();
+    pattern_contacts_ = contacts_;
+  }
+  lu_.factorize(A);
+  if (lu_.info() != Eigen::Success)
+    throw std::runtime_error("ImplicitStepper: the local implicit system is singular");
+  lu_dt_ = dt;
+}
+
+Eigen::VectorXd ImplicitStepper::local_solve(const Eigen::VectorXd& v) const {
+  if (use_blocks_) {
+    VectorXd x = p_.velocity_form ? VectorXd(v.cwiseQuotient(mloc_)) : v;
+    bcc_.solve(x);
+    return p_.velocity_form ? x : VectorXd(x.cwiseQuotient(mloc_));
+  }
+  if (!p_.gauss_newton) return lu_.solve(v);
+  // velocity form: (I + Δt M_loc K) x = v ⇔ S x = M_loc⁻¹ v;
+  // force form: (I + Δt K M_loc) x = v ⇔ S (M_loc x) = v
+  if (p_.velocity_form) return llt_.solve(VectorXd(v.cwiseQuotient(mloc_)));
+  return VectorXd(llt_.solve(v)).cwiseQuotient(mloc_);
+}
+
+}  // namespace ibrod::integrate
