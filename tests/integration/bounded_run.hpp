@@ -1,11 +1,8 @@
 #pragma once
 // Running the real binary with a time limit (a hang is killed and reported, not waited for) and
 // an optional address-space limit (RLIMIT_AS: a machine with less memory, as the child sees it).
-#include <fcntl.h>
 #include <signal.h>
-#include <sys/resource.h>
 #include <sys/wait.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <string>
@@ -27,27 +24,7 @@ struct BoundedExit {
 /// SIGKILL after timeout_s. as_limit > 0: the child's RLIMIT_AS in bytes.
 inline BoundedExit run_bounded(const std::vector<std::string>& args, const fs::path& log,
                                double timeout_s = 20, long as_limit = 0) {
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    ::dup2(fd, 1);
-    ::dup2(fd, 2);
-    const int null = ::open("/dev/null", O_RDONLY);
-    ::dup2(null, 0);
-    ::setenv("OMP_WAIT_POLICY", "passive", 0);
-    if (as_limit > 0) {
-      rlimit r{rlim_t(as_limit), rlim_t(as_limit)};
-      ::setrlimit(RLIMIT_AS, &r);
-    }
-    std::vector<char*> argv;
-    std::string bin = IBROD_BINARY;
-    argv.push_back(bin.data());
-    std::vector<std::string> copy = args;
-    for (auto& a : copy) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    ::execv(bin.c_str(), argv.data());
-    ::_exit(127);
-  }
+  const pid_t pid = spawn(args, log, 0, as_limit).pid;
   BoundedExit e;
   int st = 0;
   const auto t0 = std::chrono::steady_clock::now();

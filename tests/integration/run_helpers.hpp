@@ -42,10 +42,11 @@ struct Child {
   fs::path log;
 };
 
-/// Starts IBROD_BINARY with args. fsize_limit > 0: RLIMIT_FSIZE of the child in bytes (a full
-/// disk as the child sees it).
+/// Starts IBROD_BINARY with args, stdin from /dev/null. fsize_limit > 0: RLIMIT_FSIZE of the
+/// child in bytes (a full disk as the child sees it); as_limit > 0: its RLIMIT_AS (a machine
+/// with less memory).
 inline Child spawn(const std::vector<std::string>& args, const fs::path& log,
-                   long fsize_limit = 0) {
+                   long fsize_limit = 0, long as_limit = 0) {
   Child c;
   c.log = log;
   c.pid = ::fork();
@@ -53,6 +54,8 @@ inline Child spawn(const std::vector<std::string>& args, const fs::path& log,
     const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     ::dup2(fd, 1);
     ::dup2(fd, 2);
+    const int null = ::open("/dev/null", O_RDONLY);
+    ::dup2(null, 0);
     // Threads that sleep instead of spinning at barriers: on a machine shared with other jobs
     // (a CI runner, parallel ctest) spinning threads slow a 2-thread run down 20-fold. The
     // results do not depend on it.
@@ -60,6 +63,10 @@ inline Child spawn(const std::vector<std::string>& args, const fs::path& log,
     if (fsize_limit > 0) {
       rlimit r{rlim_t(fsize_limit), rlim_t(fsize_limit)};
       ::setrlimit(RLIMIT_FSIZE, &r);
+    }
+    if (as_limit > 0) {
+      rlimit r{rlim_t(as_limit), rlim_t(as_limit)};
+      ::setrlimit(RLIMIT_AS, &r);
     }
     std::vector<char*> argv;
     std::string bin = IBROD_BINARY;
