@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -459,15 +460,62 @@ void apply_override(Config& c, const std::string& assignment) {
   set_key(c, key, *t.get("v"));
 }
 
+namespace {
+
+// A number as config.toml writes it: the shortest text that reads back as the same double
+// (std::to_chars), with a decimal point or an exponent so that TOML reads a float (0.48, not
+// 0.47999999999999998; 725.0, not 725).
+std::string shortest(double v) {
+  char buf[64];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  std::string s(buf, r.ptr);
+  if (s.find_first_of(".eEn") == std::string::npos) s += ".0";  // n: inf/nan (never finite-checked)
+  return s;
+}
+
+// One TOML value as config.toml writes it (numbers shortest round-trip, strings as toml++).
+std::string toml_text(const toml::node& n) {
+  if (auto v = n.value_exact<double>()) return shortest(*v);
+  if (auto v = n.value_exact<int64_t>()) return std::to_string(*v);
+  if (auto v = n.value_exact<bool>()) return *v ? "true" : "false";
+  if (const toml::array* a = n.as_array()) {
+    std::string s = "[";
+    for (std::size_t i = 0; i < a->size(); ++i) s += (i ? ", " : "") + toml_text(*a->get(i));
+    return s + "]";
+  }
+  if (const toml::table* t = n.as_table()) {
+    std::string s = "{ ";
+    bool first = true;
+    for (auto&& [k, v] : *t) {
+      s += (first ? "" : ", ") + std::string(k.str()) + " = " + toml_text(v);
+      first = false;
+    }
+    return s + " }";
+  }
+  return show(n);  // a string: toml++ quotes and escapes it
+}
+
+}  // namespace
+
 std::string to_toml(const Config& c) {
-  toml::table root;
+  // one line per key, "key = value  # unit and meaning", under its [section]; numbers in their
+  // shortest round-trip form; re-runnable as is (comments are TOML comments)
+  std::ostringstream os;
+  os << "# ibrod resolved configuration (every key, defaults included; units in the comments)\n";
+  std::string section;
   for (const Key& k : schema()) {
     const std::string sec = section_of(k.name);
-    if (!root.contains(sec)) root.insert(sec, toml::table{});
-    k.put(c, *root[sec].as_table());
+    if (sec != section) {
+      os << "\n[" << sec << "]\n";
+      section = sec;
+    }
+    toml::table t;
+    k.put(c, t);
+    const std::string leaf = leaf_of(k.name);
+    std::string line = leaf + " = " + toml_text(*t.get(leaf));
+    if (line.size() < 32) line.resize(32, ' ');
+    os << line << " # " << k.help << "\n";
   }
-  std::ostringstream os;
-  os << "# ibrod resolved configuration (every key, defaults included)\n" << root << "\n";
   return os.str();
 }
 

@@ -197,7 +197,12 @@ SweepReport run_sweep(const Sweep& sw, const SweepOptions& opt) {
     }
     if (st == PointState::finished || st == PointState::interrupted) {
       // a directory of an earlier, different sweep: never resume or count it as this point
-      if (try_read_text_file(RunDir(dir).config()).value_or("") != config_text) {
+      // compared key by key (not as text): a directory written by an older ibrod, whose
+      // config.toml is laid out differently, is still the same point
+      const auto old_text = try_read_text_file(RunDir(dir).config());
+      if (!old_text ||
+          !config::config_differences(*old_text, pt.config, RunDir(dir).config().string())
+               .empty()) {
         fail(pt, "the run in " + dir.string() +
                      " has another configuration than this sweep "
                      "gives the point; move it away (or delete it) to run the point again");

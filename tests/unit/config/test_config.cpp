@@ -1,5 +1,8 @@
 // Config: defaults are MODEL §1's reference table, conversions to internal units, and every kind
 // of bad input is a ConfigError naming the key.
+#include <sstream>
+#include <vector>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -131,6 +134,54 @@ TEST(Config, ResolvedTomlRoundTrips) {
   config::apply_toml(d, config::to_toml(c), "resolved");
   EXPECT_EQ(config::describe(c), config::describe(d));
   EXPECT_NE(config::describe(c), config::describe(config::Config{}));
+}
+
+// config.toml: every key on its own line with a comment that gives its unit (the unit its name's
+// suffix promises), and numbers in their shortest form that reads back as the same double.
+TEST(Config, ResolvedTomlHasAUnitCommentPerKeyAndShortestRoundTripNumbers) {
+  config::Config c;
+  config::apply_override(c, "electrostatics.charge_e=0.48");        // 0.47999999999999998 in full
+  config::apply_override(c, "solvent.salt_M=0.30000000000000004");  // 0.1 + 0.2
+  config::apply_override(c, "time.t_end_us=0.3333333333333333");
+  config::apply_override(c, "rod.perturbation=[1, 0.1]");
+  const std::string text = config::to_toml(c);
+  EXPECT_THAT(text, HasSubstr("charge_e = 0.48 "));
+  EXPECT_THAT(text, HasSubstr("salt_M = 0.30000000000000004 "));
+  EXPECT_THAT(text, HasSubstr("t_end_us = 0.3333333333333333 "));
+  EXPECT_THAT(text, HasSubstr("box_A = 725.0 "));  // a float stays a float
+  EXPECT_THAT(text, HasSubstr("perturbation = [1.0, 0.1] "));
+  config::Config d;
+  config::apply_toml(d, text, "config.toml");
+  EXPECT_EQ(d.electrostatics_charge_e, c.electrostatics_charge_e);  // bit for bit
+  EXPECT_EQ(d.solvent_salt_M, c.solvent_salt_M);
+  EXPECT_EQ(d.time_t_end_us, c.time_t_end_us);
+  EXPECT_EQ(d.steric_stiffness_kT_A2, c.steric_stiffness_kT_A2);
+  EXPECT_EQ(config::to_toml(d), text);
+  // units promised by a key's suffix, as its comment must state them
+  const std::vector<std::pair<std::string, std::string>> unit_of = {
+      {"_per_A", "rad/Å"}, {"_A", "Å"},         {"_ns", "ns"},         {"_us", "µs"},
+      {"_kT", "kT"},       {"_M", "mol/L"},     {"_K", "K"},           {"_rad", "rad"},
+      {"_poise", "poise"}, {"_g_cm3", "g/cm³"}, {"_erg_cm", "erg·cm"}, {"_dyn", "dyn"},
+      {"_e", ", e"}};
+  std::istringstream in(text);
+  std::string line;
+  int keys = 0;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#' || line[0] == '[') continue;
+    ++keys;
+    const auto eq = line.find(" = "), hash = line.find(" # ");
+    ASSERT_NE(eq, std::string::npos) << line;
+    ASSERT_NE(hash, std::string::npos) << "no comment: " << line;
+    EXPECT_GT(line.size(), hash + 6) << "empty comment: " << line;
+    const std::string key = line.substr(0, eq), comment = line.substr(hash);
+    for (const auto& [suffix, unit] : unit_of)
+      if (key.size() > suffix.size() &&
+          key.compare(key.size() - suffix.size(), suffix.size(), suffix) == 0) {
+        EXPECT_THAT(comment, HasSubstr(unit)) << key;
+        break;
+      }
+  }
+  EXPECT_GT(keys, 40);
 }
 
 TEST(Config, ABareWordInSetIsAStringAndAWrongTypeStillNamesTheKey) {
