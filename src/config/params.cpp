@@ -201,6 +201,16 @@ std::string derived_report(const Config& c) {
   return os.str();
 }
 
+double stable_dt_limit_ns(const Config& c) {
+  // measured (docs/large_dt.md, docs/config.md): the explicit scheme of the 600 bp reference at
+  // MODEL §1's moduli and viscosity is stable to 0.22 ns with c = h = 725/64 Å, and to 0.9 ns
+  // but not 1.3 ns with c = h = 725/32 Å: the limit grows as c². The implicit scheme is stable
+  // to 20× the explicit limit (4.4 ns at the reference).
+  const double c_ref = 725.0 / 64, c_A = c.grid_kernel_width * c.grid_box_A / c.grid_n;
+  const double explicit_limit = 0.22 * (c_A / c_ref) * (c_A / c_ref);
+  return c.time_scheme == "implicit" ? 20 * explicit_limit : explicit_limit;
+}
+
 std::vector<std::string> check_warnings(const Config& c) {
   std::vector<std::string> w;
   const auto p = to_params(c);
@@ -211,6 +221,13 @@ std::vector<std::string> check_warnings(const Config& c) {
                 "diameter steric.diameter_A = " +
                 fmt(c.steric_diameter_A) +
                 " Å: the fluid cannot resolve strands in contact (raise grid.n)");
+  if (const double limit = stable_dt_limit_ns(c); c.time_dt_ns > limit)
+    w.push_back("the time step time.dt_ns = " + fmt(c.time_dt_ns) + " ns exceeds " +
+                fmt(std::round(limit * 100) / 100) + " ns, the largest step the " + c.time_scheme +
+                " scheme was measured stable at for this kernel width (c = " +
+                fmt(c.grid_kernel_width * h) +
+                " Å; docs/large_dt.md): the run may blow up (lower time.dt_ns" +
+                (c.time_scheme == "explicit" ? ", or use time.scheme = \"implicit\")" : ")"));
   const double r0 = rod::circle_radius(c.rod_base_pairs, c.rod_rise_A);
   const double kappa = p.stepper.electro.law.kappa;
   if (c.electrostatics_enabled && kappa > 0) {

@@ -184,6 +184,32 @@ TEST(Config, ResolvedTomlHasAUnitCommentPerKeyAndShortestRoundTripNumbers) {
   EXPECT_GT(keys, 40);
 }
 
+// check warns when Δt is above the scheme's measured stability limit (0.22 ns explicit, 20× that
+// implicit, at the reference grid; ∝ c² with the kernel width c), naming the key, value and limit.
+TEST(Config, CheckWarnsOfATimeStepAboveTheMeasuredStabilityLimit) {
+  const auto dt_warning = [](const std::vector<std::string>& sets) {
+    config::Config c;
+    for (const auto& s : sets) config::apply_override(c, s);
+    for (const std::string& w : config::check_warnings(c))
+      if (w.find("time.dt_ns") != std::string::npos) return w;
+    return std::string();
+  };
+  EXPECT_EQ(dt_warning({}), "");  // the reference, 0.1 ns
+  EXPECT_EQ(dt_warning({"time.dt_ns=0.22"}), "");
+  const std::string w = dt_warning({"time.dt_ns=0.3"});
+  EXPECT_THAT(w, HasSubstr("time.dt_ns = 0.3 ns exceeds 0.22 ns")) << w;
+  EXPECT_THAT(w, HasSubstr("explicit"));
+  EXPECT_THAT(w, HasSubstr("time.scheme = \"implicit\""));
+  EXPECT_EQ(dt_warning({"time.scheme=implicit", "time.dt_ns=4.4"}), "");
+  EXPECT_THAT(dt_warning({"time.scheme=implicit", "time.dt_ns=6"}),
+              HasSubstr("time.dt_ns = 6 ns exceeds 4.4 ns"));
+  // a coarser grid (c = 725/32 Å, twice the reference): measured stable at 0.9 ns, not at 1.3
+  EXPECT_EQ(dt_warning({"grid.n=32", "time.dt_ns=0.85"}), "");
+  EXPECT_THAT(dt_warning({"grid.n=32", "time.dt_ns=1.3"}), HasSubstr("exceeds 0.88 ns"));
+  // a kernel twice as wide on the reference grid is the same c
+  EXPECT_EQ(dt_warning({"grid.kernel_width=2", "time.dt_ns=0.85"}), "");
+}
+
 TEST(Config, ABareWordInSetIsAStringAndAWrongTypeStillNamesTheKey) {
   config::Config c;
   config::apply_override(c, "time.scheme=implicit");
