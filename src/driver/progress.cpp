@@ -11,9 +11,9 @@ Progress::Progress(std::FILE* out, int tty, double interval_s, double tty_interv
 
 Progress::~Progress() { finish_line(); }
 
-bool Progress::update(const std::string& line, double now_s, bool last) {
+bool Progress::update(const std::string& line, double now_s, bool last, bool force) {
   if (!out_) return false;
-  if (printed_any_ && !last && now_s - last_s_ < interval_s_) return false;
+  if (printed_any_ && !last && !force && now_s - last_s_ < interval_s_) return false;
   printed_any_ = true;
   last_s_ = now_s;
   if (tty_) {

@@ -18,7 +18,9 @@ class Progress {
   /// Offers a progress line at wall time now_s (any monotonic clock, s). Printed if the first,
   /// if `last`, or if the interval since the previous printed line has passed. Returns whether
   /// it was printed.
-  bool update(const std::string& line, double now_s, bool last = false);
+  /// `force`: printed whatever the interval (the line before the first step, the first output
+  /// step's), without ending an in-place line.
+  bool update(const std::string& line, double now_s, bool last = false, bool force = false);
   /// Prints a line of its own (not throttled).
   void message(const std::string& line);
   /// Ends an in-place line (no-op otherwise).

@@ -147,6 +147,11 @@ std::string Run::State::progress_line(const sim::Observables& o) const {
                 static_cast<long long>(sim->step_count()), static_cast<long long>(end),
                 sim->time() / 1e-6, o.writhe, o.link, o.E_kinetic_kT, ms,
                 format_duration(1e-3 * ms * double(end - sim->step_count())).c_str());
+  if (sim->step_count() == start_step) {
+    // before the first step of this process: the state's values, no timing yet
+    std::string line(buf);
+    return line.substr(0, line.find("kT  ") + 2) + "  (starting)";
+  }
   return buf;
 }
 
@@ -297,6 +302,11 @@ RunResult Run::State::loop(const SignalGuard& signals) {
       last_row = s.observe();
     }
 
+    // a line at once, with the state's real values (a large grid's first output step may be
+    // minutes away)
+    if (!s.at_end()) progress.update(progress_line(last_row), 0.0, false, /*force=*/true);
+    bool shown_output_step = false;
+
     StopReason reason = StopReason::none;
     if (s.at_end()) {
       // resumed at its end time (a checkpoint at t_end, or t_end moved to it): stop here
@@ -341,11 +351,15 @@ RunResult Run::State::loop(const SignalGuard& signals) {
         progress.update(progress_line(last_row), now, /*last=*/true);
         break;
       }
-      // the first line at the first output step or after one interval, whichever comes first,
+      // a line at the first output step (ms/step and ETA now measured) and after one interval,
       // then by the clock (with the latest row: ms/step and ETA are current, the observables are
       // those of the last output step)
-      if ((output_step && !progress.started()) || progress.due(now))
+      if (output_step && !shown_output_step) {
+        progress.update(progress_line(last_row), now, false, /*force=*/true);  // with ms/step
+        shown_output_step = true;
+      } else if (progress.due(now)) {
         progress.update(progress_line(last_row), now);
+      }
     }
     result.reason = reason;
     finish(last_row, to_string(reason), "");

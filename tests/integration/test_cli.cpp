@@ -66,6 +66,15 @@ TEST(Cli, RunWritesEveryOutputFile) {
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_THAT(r.output, HasSubstr("ms/step"));
   EXPECT_THAT(r.output, HasSubstr("ETA"));
+  // a line before the first step, with the initial state's values (Lk = ΔLk = 2, Wr = 0), then
+  // one at the first output step (step 100) with the measured ms/step
+  const auto first = r.output.find("step 0/500  t = 0.0000 us  Wr = +0.0000  Lk = +2.0000");
+  EXPECT_NE(first, std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("(starting)", first), std::string::npos) << r.output;
+  const auto at100 = r.output.find("step 100/500");
+  EXPECT_NE(at100, std::string::npos) << r.output;
+  EXPECT_LT(first, at100);
+  EXPECT_NE(r.output.find("ms/step", at100), std::string::npos) << r.output;
   const fs::path out = d / "out";
   // config.toml is the resolved config: every key, including defaults, with our overrides
   const std::string cfg = read_file(out / "config.toml");
