@@ -147,6 +147,12 @@ void add_analysis_commands(CLI::App& app) {
       ->delimiter(',')
       ->default_str(join(r->opt.views));
   render->add_option("--size", r->size, "image size WxH in pixels")->capture_default_str();
+  render->add_flag("--force", r->opt.force,
+                   "replace pictures that exist (without it an existing file is an error)");
+  render->add_flag("--movie", r->opt.movie,
+                   "every frame of DIR/trajectory.h5 from the first view, at one scale, into "
+                   "DIR/render/movie_<view>/frame_NNNNN.png, and DIR/render/rod_<view>.mp4 with "
+                   "ffmpeg if installed");
   render->callback([r] {
     finish([&] {
       ibrod::analysis::parse_size(r->size, r->opt.width, r->opt.height);

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <sstream>
 
@@ -28,6 +29,21 @@ std::string time_label(double t_us) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.4f", t_us);
   return buf;
+}
+
+// The frames frame_%05d.png of `frames_dir` as an H.264 MP4 at 10 frames/s with ffmpeg, if it is
+// on PATH: the file written, or "" without ffmpeg. A failed ffmpeg is a RunError.
+std::string encode_movie(const fs::path& frames_dir, const fs::path& mp4) {
+  if (std::system("command -v ffmpeg >/dev/null 2>&1") != 0) return "";
+  const std::string cmd = "ffmpeg -y -loglevel error -framerate 10 -i '" + frames_dir.string() +
+                          "/frame_%05d.png' -vf 'scale=trunc(iw/2)*2:trunc(ih/2)*2' -pix_fmt "
+                          "yuv420p '" +
+                          mp4.string() + "' </dev/null";
+  if (frames_dir.string().find('\'') != std::string::npos ||
+      mp4.string().find('\'') != std::string::npos)
+    throw RunError("render: cannot pass a path with a quote (') to ffmpeg: " + mp4.string());
+  if (std::system(cmd.c_str()) != 0) throw RunError("render: ffmpeg failed: " + cmd);
+  return mp4.string();
 }
 
 }  // namespace
@@ -66,31 +82,13 @@ RodFrame read_final_state(const fs::path& dir) {
   return f;
 }
 
-std::vector<RodFrame> read_trajectory_frames(const fs::path& dir,
-                                             std::span<const double> times_us) {
-  const fs::path p = RunDir(dir).trajectory();
-  if (!fs::exists(p)) throw ConfigError("'" + p.string() + "' does not exist");
-  H5mdSeries pos, d1;
-  try {
-    pos = read_h5md_series(p, "position");
-    d1 = read_h5md_series(p, "d1");
-  } catch (const RunError& e) {
-    throw ConfigError(std::string("cannot read the trajectory: ") + e.what());
-  }
-  const std::size_t T = pos.time_us.size();
-  if (T == 0 || pos.n < 2 || d1.time_us.size() != T || d1.n != pos.n)
-    throw ConfigError("'" + p.string() + "' has no frames (or position and d1 disagree)");
-  std::vector<std::size_t> picks;
-  for (double want : times_us) {
-    std::size_t best = 0;
-    for (std::size_t i = 1; i < T; ++i)
-      if (std::abs(pos.time_us[i] - want) < std::abs(pos.time_us[best] - want)) best = i;
-    picks.push_back(best);
-  }
-  std::sort(picks.begin(), picks.end());
-  picks.erase(std::unique(picks.begin(), picks.end()), picks.end());
+namespace {
+
+// Frames i of the series (pos, d1), in the order given.
+std::vector<RodFrame> frames_of(const H5mdSeries& pos, const H5mdSeries& d1,
+                                const std::vector<std::size_t>& picks) {
   std::vector<RodFrame> frames;
-  const std::size_t n = std::size_t(pos.n);
+  const std::size_t n = std::size_t(pos.n), T = pos.time_us.size();
   for (std::size_t i : picks) {
     RodFrame f;
     f.step = pos.step.size() == T ? pos.step[i] : -1;
@@ -104,6 +102,48 @@ std::vector<RodFrame> read_trajectory_frames(const fs::path& dir,
     frames.push_back(std::move(f));
   }
   return frames;
+}
+
+void read_series(const fs::path& dir, H5mdSeries& pos, H5mdSeries& d1) {
+  const fs::path p = RunDir(dir).trajectory();
+  if (!fs::exists(p)) throw ConfigError("'" + p.string() + "' does not exist");
+  try {
+    pos = read_h5md_series(p, "position");
+    d1 = read_h5md_series(p, "d1");
+  } catch (const RunError& e) {
+    throw ConfigError(std::string("cannot read the trajectory: ") + e.what());
+  }
+  const std::size_t T = pos.time_us.size();
+  if (T == 0 || pos.n < 2 || d1.time_us.size() != T || d1.n != pos.n)
+    throw ConfigError("'" + p.string() + "' has no frames (or position and d1 disagree)");
+}
+
+}  // namespace
+
+std::vector<RodFrame> read_all_trajectory_frames(const fs::path& dir) {
+  H5mdSeries pos, d1;
+  read_series(dir, pos, d1);
+  std::vector<std::size_t> all(pos.time_us.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+  return frames_of(pos, d1, all);
+}
+
+std::vector<RodFrame> read_trajectory_frames(const fs::path& dir, std::span<const double> times_us,
+                                             std::pair<double, double>* span_us) {
+  H5mdSeries pos, d1;
+  read_series(dir, pos, d1);
+  const std::size_t T = pos.time_us.size();
+  if (span_us) *span_us = {pos.time_us.front(), pos.time_us.back()};
+  std::vector<std::size_t> picks;
+  for (double want : times_us) {
+    std::size_t best = 0;
+    for (std::size_t i = 1; i < T; ++i)
+      if (std::abs(pos.time_us[i] - want) < std::abs(pos.time_us[best] - want)) best = i;
+    picks.push_back(best);
+  }
+  std::sort(picks.begin(), picks.end());
+  picks.erase(std::unique(picks.begin(), picks.end()), picks.end());
+  return frames_of(pos, d1, picks);
 }
 
 // ---- render
@@ -153,9 +193,22 @@ std::vector<fs::path> render_run(const fs::path& dir, const RenderOptions& opt, 
     }
   }
   std::vector<RodFrame> frames;
-  if (!times.empty()) {
+  if (opt.movie) {
+    frames = read_all_trajectory_frames(dir);
+  } else if (!times.empty()) {
     if (fs::exists(RunDir(dir).trajectory())) {
-      frames = read_trajectory_frames(dir, times);
+      std::pair<double, double> span;
+      frames = read_trajectory_frames(dir, times, &span);
+      // a time outside the trajectory is drawn at its nearest end: say so (to stderr)
+      const double slack = 1e-9 + 1e-9 * std::abs(span.second);
+      for (double t : times)
+        if (t < span.first - slack || t > span.second + slack)
+          std::fprintf(stderr,
+                       "ibrod render: warning: --time %s us is outside the trajectory (t = %s to "
+                       "%s us): drawing the frame at t = %s us\n",
+                       time_label(t).c_str(), time_label(span.first).c_str(),
+                       time_label(span.second).c_str(),
+                       time_label(t < span.first ? span.first : span.second).c_str());
       if (log)
         for (const auto& f : frames)
           std::fprintf(log, "render: frame at t = %s us (step %lld)\n",
@@ -169,26 +222,83 @@ std::vector<fs::path> render_run(const fs::path& dir, const RenderOptions& opt, 
       want_final = true;
     }
   }
-  if (want_final) frames.push_back(read_final_state(dir));
+  if (want_final && !opt.movie) frames.push_back(read_final_state(dir));
 
   const RunInfo info = read_run_info(dir);
   const fs::path out = RunDir(dir).render_dir();
   std::error_code ec;
   fs::create_directories(out, ec);
   if (ec) throw RunError("render: cannot create '" + out.string() + "': " + ec.message());
-  std::vector<fs::path> written;
-  for (const auto& f : frames) {
-    for (const auto& v : views) {
-      const render::Image img =
-          render::render_rod(f.X, f.d1, info.diameter_A, v, opt.width, opt.height);
-      const fs::path file = out / ("rod_" + v.name + "_t" + time_label(f.time_us) + ".png");
-      try {
-        render::write_png(file.string(), img);
-      } catch (const std::runtime_error& e) {
-        throw RunError(std::string("render: ") + e.what());
+  // the files, checked before anything is drawn: an existing picture is never silently replaced
+  std::vector<std::pair<fs::path, std::size_t>> jobs;  // file, frame (× view below)
+  std::vector<render::View> job_view;
+  const fs::path movie_dir = out / ("movie_" + views.front().name);
+  if (opt.movie) {
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+      char name[32];
+      std::snprintf(name, sizeof name, "frame_%05zu.png", i);
+      jobs.push_back({movie_dir / name, i});
+      job_view.push_back(views.front());
+    }
+  } else {
+    for (std::size_t i = 0; i < frames.size(); ++i)
+      for (const auto& v : views) {
+        jobs.push_back(
+            {out / ("rod_" + v.name + "_t" + time_label(frames[i].time_us) + ".png"), i});
+        job_view.push_back(v);
       }
-      if (log) std::fprintf(log, "%s\n", file.c_str());
-      written.push_back(file);
+  }
+  const fs::path movie_file = out / ("rod_" + views.front().name + ".mp4");
+  if (!opt.force) {
+    for (const auto& [file, i] : jobs)
+      if (fs::exists(file))
+        throw ConfigError("render: '" + file.string() +
+                          "' exists (an earlier render, perhaps at another --size); give "
+                          "--force to replace it, or move it away");
+    if (opt.movie && fs::exists(movie_file))
+      throw ConfigError("render: '" + movie_file.string() +
+                        "' exists; give --force to replace it, or move it away");
+  }
+  if (opt.movie) {
+    fs::create_directories(movie_dir, ec);
+    if (ec) throw RunError("render: cannot create '" + movie_dir.string() + "': " + ec.message());
+    // a frame left from a longer earlier movie would join this one
+    for (const auto& e : fs::directory_iterator(movie_dir))
+      if (e.path().extension() == ".png") fs::remove(e.path());
+  }
+  // a movie keeps one scale and centre: every frame's points frame every picture
+  std::vector<Vec3> all_points;
+  if (opt.movie)
+    for (const auto& f : frames) all_points.insert(all_points.end(), f.X.begin(), f.X.end());
+
+  std::vector<fs::path> written;
+  for (std::size_t j = 0; j < jobs.size(); ++j) {
+    const auto& [file, i] = jobs[j];
+    const RodFrame& f = frames[i];
+    const render::Image img = render::render_rod(f.X, f.d1, info.diameter_A, job_view[j], opt.width,
+                                                 opt.height, {}, all_points);
+    try {
+      render::write_png(file.string(), img);
+    } catch (const std::runtime_error& e) {
+      throw RunError(std::string("render: ") + e.what());
+    }
+    if (log && !opt.movie) std::fprintf(log, "%s\n", file.c_str());
+    written.push_back(file);
+  }
+  if (opt.movie) {
+    if (log)
+      std::fprintf(log, "render: %zu frames (t = %s to %s us) in %s\n", frames.size(),
+                   time_label(frames.front().time_us).c_str(),
+                   time_label(frames.back().time_us).c_str(), movie_dir.c_str());
+    if (const std::string mp4 = encode_movie(movie_dir, movie_file); !mp4.empty()) {
+      if (log) std::fprintf(log, "%s\n", mp4.c_str());
+      written.push_back(mp4);
+    } else if (log) {
+      std::fprintf(log,
+                   "render: ffmpeg not found on PATH (Debian package ffmpeg), so no MP4: the "
+                   "frames are the movie (e.g. ffmpeg -framerate 10 -i %s/frame_%%05d.png "
+                   "-pix_fmt yuv420p %s)\n",
+                   movie_dir.c_str(), movie_file.c_str());
     }
   }
   return written;

@@ -58,7 +58,8 @@ View standard_view(const std::string& name) {
 }
 
 Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diameter,
-                 const View& view, int width, int height, const Style& style) {
+                 const View& view, int width, int height, const Style& style,
+                 std::span<const Vec3> frame) {
   const std::size_t n = X.size();
   if (n < 2) throw std::invalid_argument("render_rod: needs at least 2 points");
   if (d1.size() != n)
@@ -80,16 +81,23 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
   const Vec3 u = r.cross(f);
   const double R = 0.5 * diameter;
 
-  // centre and scale: the tube's bounding sphere fills the image less the margins
-  Vec3 c = Vec3::Zero();
-  for (const auto& x : X) c += x;
-  c /= double(n);
-  double rho = 0;
-  for (const auto& x : X) rho = std::max(rho, (x - c).norm());
-  rho += R;
-  const double usable = 0.5 * std::min(W, H) * (1 - 2 * style.margin);
-  const double scale = usable / rho;  // pixels (supersampled) per length unit
-  const Vec3 eye = c - 2 * rho * f;   // rays start on a plane in front of everything
+  // centre and scale (tight framing): the box the tube covers on the image plane, centred, fills
+  // the image less the margins along its limiting side
+  const std::span<const Vec3> fr = frame.empty() ? X : frame;
+  double lo_r = std::numeric_limits<double>::infinity(), hi_r = -lo_r, lo_u = lo_r, hi_u = -lo_r,
+         lo_f = lo_r;
+  for (const auto& x : fr) {
+    lo_r = std::min(lo_r, x.dot(r)), hi_r = std::max(hi_r, x.dot(r));
+    lo_u = std::min(lo_u, x.dot(u)), hi_u = std::max(hi_u, x.dot(u));
+    lo_f = std::min(lo_f, x.dot(f));
+  }
+  const double margin_px = style.margin * std::min(W, H);
+  const double scale =  // pixels (supersampled) per length unit
+      std::min((W - 2 * margin_px) / (hi_r - lo_r + 2 * R),
+               (H - 2 * margin_px) / (hi_u - lo_u + 2 * R));
+  // the centre c: mid-box on the image plane; along f, in front of every point
+  const Vec3 c = 0.5 * (lo_r + hi_r) * r + 0.5 * (lo_u + hi_u) * u + (lo_f - 2 * R) * f;
+  const Vec3 eye = c;  // rays start on a plane in front of everything
 
   // light from the upper left, in front of the rod
   const Vec3 light = (-0.45 * r + 0.6 * u - 0.65 * f).normalized();

@@ -44,10 +44,13 @@ struct Style {
 
 /// Renders the tube of diameter `diameter` (X's length unit) about the closed polygon X with the
 /// stripe along d1 (one director per point; interpolated along each segment and projected ⟂ to
-/// it), seen from `view`, into a width × height image. The scale fits the bounding sphere of the
-/// tube about the centroid of X into the image, so every view of one configuration has the same
-/// scale and centre. X.size() ≥ 2 and d1.size() = X.size(), else std::invalid_argument.
+/// it), seen from `view`, into a width × height image. Tight framing: the box that the tube
+/// about the points `frame` (empty: X itself) covers on the image plane is centred and fills
+/// the image less the margins along its limiting side (pass every frame of a movie as `frame`
+/// so that all its pictures share one scale and centre). X.size() ≥ 2 and d1.size() = X.size(),
+/// else std::invalid_argument.
 Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diameter,
-                 const View& view, int width, int height, const Style& style = {});
+                 const View& view, int width, int height, const Style& style = {},
+                 std::span<const Vec3> frame = {});
 
 }  // namespace ibrod::render

@@ -101,6 +101,48 @@ class PlotsAndReport(unittest.TestCase):
         self.assertIn("frame at t = 0.0120 us", r.stdout)
         self.png(os.path.join(self.a, "render", "rod_side_t0.0120.png"))
         self.assertEqual(sh(BINARY, "render", self.a, "--views", "diagonal", check=False).returncode, 2)
+        # an existing picture is never silently replaced: refused (exit 2, naming the file and
+        # --force, the file untouched), replaced with --force
+        side = os.path.join(self.a, "render", "rod_side_t0.0120.png")
+        before = os.stat(side).st_mtime_ns
+        r = sh(BINARY, "render", self.a, "--time", "0.0123", "--views", "side", "--size", "80x80",
+               check=False)
+        self.assertEqual(r.returncode, 2, r.stdout)
+        self.assertIn("rod_side_t0.0120.png", r.stdout)
+        self.assertIn("--force", r.stdout)
+        self.assertEqual(os.stat(side).st_mtime_ns, before)
+        self.assertEqual(self.png(side).shape[:2], (64, 64))
+        sh(BINARY, "render", self.a, "--time", "0.0123", "--views", "side", "--size", "80x80",
+           "--force")
+        self.assertEqual(self.png(side).shape[:2], (80, 80))
+        # a time outside the trajectory (0 to 0.03 µs): drawn at the last frame, with a warning
+        r = sh(BINARY, "render", self.a, "--time", "99", "--views", "side", "--size", "32x32")
+        self.assertIn("warning: --time 99.0000 us is outside the trajectory", r.stdout)
+        self.assertIn("t = 0.0000 to 0.0300 us", r.stdout)
+        self.png(os.path.join(self.a, "render", "rod_side_t0.0300.png"))
+        r = sh(BINARY, "render", self.a, "--time", "0.01", "--views", "front", "--size", "32x32")
+        self.assertNotIn("warning", r.stdout)
+
+    def test_1b_movie(self):
+        # every frame of trajectory.h5 (16: steps 0, 20, …, 300) from the first view, one scale;
+        # an MP4 with ffmpeg, else a message saying so
+        r = sh(BINARY, "render", self.b, "--movie", "--views", "oblique", "--size", "48x40")
+        movie = os.path.join(self.b, "render", "movie_oblique")
+        frames = sorted(os.listdir(movie))
+        self.assertEqual(frames, [f"frame_{i:05d}.png" for i in range(16)], r.stdout)
+        self.assertEqual(self.png(os.path.join(movie, frames[-1])).shape[:2], (40, 48))
+        self.assertIn("16 frames (t = 0.0000 to 0.0300 us)", r.stdout)
+        mp4 = os.path.join(self.b, "render", "rod_oblique.mp4")
+        if shutil.which("ffmpeg"):
+            self.assertTrue(os.path.getsize(mp4) > 0)
+        else:
+            self.assertIn("ffmpeg not found", r.stdout)
+            self.assertFalse(os.path.exists(mp4))
+        # again: refused without --force, the frames kept
+        self.assertEqual(sh(BINARY, "render", self.b, "--movie", "--views", "oblique",
+                            check=False).returncode, 2)
+        self.assertEqual(len(os.listdir(movie)), 16)
+        shutil.rmtree(os.path.join(self.b, "render"))  # test_3 renders b through the report
         self.assertEqual(sh(BINARY, "analyze", os.path.join(self.tmp, "none"), check=False).returncode, 2)
 
     def test_2_plot(self):

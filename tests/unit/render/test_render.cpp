@@ -6,6 +6,8 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <numbers>
@@ -154,6 +156,52 @@ TEST(Render, TwistWindsTheStripeAroundTheTube) {
   // 4 turns: 4 runs, the one through angle 0 counted at both ends at most
   EXPECT_GE(runs, 4);
   EXPECT_LE(runs, 5);
+}
+
+/// The box of the pixels that are not background: {x0, y0, x1, y1} (inclusive).
+std::array<int, 4> foreground_box(const Image& img) {
+  std::array<int, 4> b{img.width, img.height, -1, -1};
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x)
+      if (!is_background(img.at(x, y)))
+        b = {std::min(b[0], x), std::min(b[1], y), std::max(b[2], x), std::max(b[3], y)};
+  return b;
+}
+
+TEST(Render, TightFramingFillsTheImageAlongTheLimitingSideAndCentresTheOther) {
+  // an elongated closed loop (semi-axes 300 and 40 Å, not centred at the origin), top view,
+  // 300×200 px: the long side fills the width less the margins, the short one is centred
+  std::vector<Vec3> X, d1;
+  const int n = 400;
+  for (int k = 0; k < n; ++k) {
+    const double s = 2 * kPi * k / n;
+    X.emplace_back(50 + 300 * std::cos(s), -20 + 40 * std::sin(s), 7);
+    d1.emplace_back(0, 0, 1);
+  }
+  const int w = 300, h = 200;
+  const Image img = render_rod(X, d1, 20.0, standard_view("top"), w, h);
+  const auto b = foreground_box(img);
+  const int margin = int(std::lround(Style{}.margin * std::min(w, h)));  // 8 px
+  EXPECT_NEAR(b[0], margin, 2);
+  EXPECT_NEAR(b[2], w - 1 - margin, 2);
+  const int top = b[1], bottom = h - 1 - b[3];
+  EXPECT_NEAR(top, bottom, 2);
+  // height of the loop's picture: (2·40 + 20) Å at the scale (w − 2 margin) / (2·300 + 20) px/Å
+  EXPECT_NEAR(b[3] - b[1] + 1, 100.0 * (w - 2 * margin) / 620.0, 3);
+}
+
+TEST(Render, AGivenFrameSetsScaleAndCentreForEveryPicture) {
+  // a movie: a ring of 50 Å framed by the points of a ring of 100 Å about the same centre is
+  // drawn at the larger ring's scale (half as large), centred
+  const Ring small(200, 50.0), large(200, 100.0);
+  const int w = 200, h = 200;
+  const Image img =
+      render_rod(small.X, small.d1, 20.0, standard_view("top"), w, h, Style{}, large.X);
+  const auto b = foreground_box(img);
+  const double scale = (w - 2 * Style{}.margin * w) / (2 * 100.0 + 20);
+  EXPECT_NEAR(b[2] - b[0] + 1, (2 * 50.0 + 20) * scale, 3);
+  EXPECT_NEAR(b[0], w - 1 - b[2], 2);
+  EXPECT_NEAR(b[1], h - 1 - b[3], 2);
 }
 
 TEST(Render, BadInputThrows) {
