@@ -17,6 +17,7 @@ packages=(
   libpng-dev            # rendered pictures of the rod
   python3 python3-numpy python3-matplotlib python3-h5py   # analysis and plots
   python3-mdanalysis    # tests: MDAnalysis reads trajectory.h5 (H5MD)
+  python3-vtk9          # tests: VTK's own readers open the .vtp/.vti files
 )
 
 missing=()

@@ -9,6 +9,8 @@ Runs IBROD (argv[1]) on a small configuration, then checks
                  one Piece, array sizes against NumberOfPoints/NumberOfLines/extents, component
                  counts, a closed polyline, points equal to the H5MD frames, DataSet files present.
   trajectory.h5  with MDAnalysis's H5MD reader too (frames, positions, time units);
+  vtk/*.vtp, vtk/*.vti  with VTK's own readers too (python3-vtk9: vtkXMLPolyDataReader,
+                 vtkXMLImageDataReader): points, the closed line, arrays, dimensions, spacing;
 Exit status 0 if every check passes; the first failed check is printed.
 Must run with /usr/bin/python3 (numpy and h5py from Debian).
 """
@@ -182,6 +184,51 @@ def check_vti(path):
     check(u.size == 3 * GRID ** 3 and np.all(np.isfinite(u)), path + ": velocity count")
 
 
+def vtk_read(reader_class, path):
+    """Reads path with VTK's own XML reader (python3-vtk9); fails on any VTK error."""
+    import vtk
+    errors = []
+    reader = reader_class()
+    reader.AddObserver("ErrorEvent", lambda obj, ev: errors.append(ev))
+    check(reader.CanReadFile(path) == 1, path + ": VTK cannot read it")
+    reader.SetFileName(path)
+    reader.Update()
+    check(not errors and reader.GetErrorCode() == 0, path + ": VTK reader errors")
+    from vtk.util.numpy_support import vtk_to_numpy
+    return reader.GetOutput(), vtk_to_numpy
+
+
+def check_vtk_readers(out, positions, vtp_files, vti_files):
+    """VTK's own readers (vtkXMLPolyDataReader, vtkXMLImageDataReader) open every .vtp and .vti."""
+    import vtk
+    for path, frame in zip(vtp_files, positions):
+        poly, to_np = vtk_read(vtk.vtkXMLPolyDataReader, path)
+        check(poly.GetNumberOfPoints() == N, path + ": VTK points")
+        check(np.allclose(to_np(poly.GetPoints().GetData()), frame, rtol=1e-9, atol=1e-8),
+              path + ": VTK points = H5MD frame")
+        check(poly.GetNumberOfLines() == 1, path + ": VTK one line")
+        ids = vtk.vtkIdList()
+        poly.GetLines().InitTraversal()
+        poly.GetLines().GetNextCell(ids)
+        check(ids.GetNumberOfIds() == N + 1 and ids.GetId(0) == ids.GetId(N), path + ": VTK closed line")
+        pd = poly.GetPointData()
+        for name, comps in (("d1", 3), ("d2", 3), ("d3", 3), ("twist_density_rad_per_A", 1),
+                            ("stretch_strain", 1)):
+            a = pd.GetArray(name)
+            check(a is not None and a.GetNumberOfComponents() == comps
+                  and a.GetNumberOfTuples() == N, path + ": VTK array " + name)
+        d1 = to_np(pd.GetArray("d1"))
+        check(np.allclose(np.linalg.norm(d1, axis=1), 1, atol=1e-9), path + ": VTK d1 unit")
+    for path in vti_files:
+        img, to_np = vtk_read(vtk.vtkXMLImageDataReader, path)
+        check(list(img.GetDimensions()) == [GRID] * 3, path + ": VTK dimensions")
+        check(np.allclose(img.GetSpacing(), [BOX / GRID] * 3), path + ": VTK spacing")
+        v = img.GetPointData().GetArray("velocity_A_per_ns")
+        check(v is not None and v.GetNumberOfComponents() == 3
+              and v.GetNumberOfTuples() == GRID ** 3, path + ": VTK velocity")
+        check(np.all(np.isfinite(to_np(v))), path + ": VTK velocity finite")
+
+
 def check_pvd(d, name, ext, times):
     root = check_vtkfile(os.path.join(d, name), "Collection")
     sets = root.findall("Collection/DataSet")
@@ -205,12 +252,15 @@ def main():
         check(r.returncode == 0, "ibrod run failed:\n" + r.stdout + r.stderr)
         positions, times = check_h5md(out)
         check_mdanalysis(out, positions)
-        for path, frame in zip(check_pvd(out, "rod.pvd", ".vtp", times), positions):
+        vtp_files = check_pvd(out, "rod.pvd", ".vtp", times)
+        vti_files = check_pvd(out, "fluid.pvd", ".vti", times)
+        for path, frame in zip(vtp_files, positions):
             check_vtp(path, frame)
-        for path in check_pvd(out, "fluid.pvd", ".vti", times):
+        for path in vti_files:
             check_vti(path)
-        print("check_outputs: H5MD (h5py and MDAnalysis), %d .vtp and %d .vti files OK"
-              % (len(times), len(times)))
+        check_vtk_readers(out, positions, vtp_files, vti_files)
+        print("check_outputs: H5MD (h5py and MDAnalysis), %d .vtp and %d .vti files (xml.etree "
+              "and VTK's readers) OK" % (len(times), len(times)))
         return 0
     except AssertionError as e:
         print("check_outputs: FAILED: %s" % e)
