@@ -149,6 +149,14 @@ void add_analysis_commands(CLI::App& app) {
   render->add_option("--size", r->size, "image size WxH in pixels")->capture_default_str();
   render->add_flag("--force", r->opt.force,
                    "replace pictures that exist (without it an existing file is an error)");
+  render
+      ->add_option("--colour", r->opt.colour,
+                   "body colour: stripe (blue, with an orange stripe along D1), along (a colour "
+                   "map from the first point to the last) or height (a colour map of z)")
+      ->check(CLI::IsMember({"stripe", "along", "height"}))
+      ->capture_default_str();
+  render->add_flag("!--no-labels", r->opt.labels,
+                   "no time, Wr, ΔLk, Cs and scale bar on the pictures");
   render->add_flag("--movie", r->opt.movie,
                    "every frame of DIR/trajectory.h5 from the first view, at one scale, into "
                    "DIR/render/movie_<view>/frame_NNNNN.png, and DIR/render/rod_<view>.mp4 with "

@@ -11,6 +11,7 @@
 
 #include "core/error.hpp"
 #include "core/text_file.hpp"
+#include "diagnostics/topology.hpp"
 #include "io/csv.hpp"
 #include "io/h5md.hpp"
 #include "io/run_dir.hpp"
@@ -271,12 +272,36 @@ std::vector<fs::path> render_run(const fs::path& dir, const RenderOptions& opt, 
   if (opt.movie)
     for (const auto& f : frames) all_points.insert(all_points.end(), f.X.begin(), f.X.end());
 
+  render::Style style;
+  if (opt.colour == "along")
+    style.colouring = render::Colouring::along;
+  else if (opt.colour == "height")
+    style.colouring = render::Colouring::height;
+  else if (opt.colour != "stripe")
+    throw ConfigError("--colour '" + opt.colour + "': expected stripe, along or height");
+  // labels need about 50 px of height and 130 of width (font 5×7 px): smaller pictures go without
+  const bool labels = opt.labels && opt.height >= 120 && opt.width >= 160;
+  if (opt.labels && !labels && log)
+    std::fprintf(log, "render: no labels or scale bar below 160x120 pixels\n");
+  style.scale_bar = labels;
+
   std::vector<fs::path> written;
   for (std::size_t j = 0; j < jobs.size(); ++j) {
     const auto& [file, i] = jobs[j];
     const RodFrame& f = frames[i];
-    const render::Image img = render::render_rod(f.X, f.d1, info.diameter_A, job_view[j], opt.width,
-                                                 opt.height, {}, all_points);
+    if (labels) {
+      char wr[64], lk[96];
+      std::snprintf(wr, sizeof wr, "Wr = %.3f", diagnostics::writhe(f.X));
+      std::snprintf(lk, sizeof lk, "ΔLk = %d   Cs = %g M", info.excess_link, info.salt_M);
+      style.labels = {"t = " + time_label(f.time_us) + " µs", wr, lk};
+    }
+    render::Image img;
+    try {
+      img = render::render_rod(f.X, f.d1, info.diameter_A, job_view[j], opt.width, opt.height,
+                               style, all_points);
+    } catch (const std::invalid_argument& e) {
+      throw ConfigError(std::string("render: ") + e.what() + " (a larger --size, or --no-labels)");
+    }
     try {
       render::write_png(file.string(), img);
     } catch (const std::runtime_error& e) {

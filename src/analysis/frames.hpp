@@ -43,6 +43,8 @@ struct RenderOptions {
   int height = 800;
   bool force = false;  ///< replace pictures that exist (else ConfigError naming the file)
   bool movie = false;  ///< every frame of the trajectory, one view (movie_<view>/, + MP4)
+  bool labels = true;  ///< time, Wr, ΔLk and Cs at the top left and a scale bar in Å
+  std::string colour = "stripe";  ///< "stripe" | "along" (index along the rod) | "height" (z)
 };
 
 /// Parses "WxH" (e.g. "800x600") into width and height; ConfigError if malformed or not in

@@ -3,8 +3,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <stdexcept>
+#include <string>
+
+#include "render/text.hpp"
 
 namespace ibrod::render {
 
@@ -39,6 +43,18 @@ Hit ray_capsule(const Vec3& ro, const Vec3& rd, const Vec3& a, const Vec3& b, do
 }
 
 std::uint8_t to_byte(double v) { return std::uint8_t(std::clamp(std::lround(v), 0L, 255L)); }
+
+// A colour map of t in [0, 1]: blue → cyan → green → yellow → red (piecewise linear).
+Rgb colour_map(double t) {
+  static const double stops[5][3] = {
+      {40, 70, 200}, {30, 170, 210}, {60, 180, 80}, {235, 200, 40}, {210, 50, 40}};
+  t = std::clamp(t, 0.0, 1.0) * 4;
+  const int i = std::min(3, int(t));
+  const double f = t - i;
+  return {to_byte((1 - f) * stops[i][0] + f * stops[i + 1][0]),
+          to_byte((1 - f) * stops[i][1] + f * stops[i + 1][1]),
+          to_byte((1 - f) * stops[i][2] + f * stops[i + 1][2])};
+}
 
 }  // namespace
 
@@ -92,9 +108,19 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
     lo_f = std::min(lo_f, x.dot(f));
   }
   const double margin_px = style.margin * std::min(W, H);
+  // bands for the labels (top) and the scale bar (bottom), in final pixels, kept free of the rod
+  const int fs = std::max(1, int(std::lround(std::min(width, height) / 400.0)));  // font scale
+  const int line_h = (kGlyphH + 3) * fs, pad = 3 * fs;
+  const int top_band = style.labels.empty() ? 0 : int(style.labels.size()) * line_h + pad;
+  const int bottom_band = style.scale_bar ? (kGlyphH + 3) * fs + pad : 0;
+  const double avail_h = H - 2 * margin_px - double(S) * (top_band + bottom_band);
+  if (!(avail_h > 0))
+    throw std::invalid_argument("render_rod: image height " + std::to_string(height) +
+                                " leaves no room for the rod beside its labels");
   const double scale =  // pixels (supersampled) per length unit
-      std::min((W - 2 * margin_px) / (hi_r - lo_r + 2 * R),
-               (H - 2 * margin_px) / (hi_u - lo_u + 2 * R));
+      std::min((W - 2 * margin_px) / (hi_r - lo_r + 2 * R), avail_h / (hi_u - lo_u + 2 * R));
+  // the box's centre goes to the centre of the free region
+  const double ox = 0.5 * W, oy = 0.5 * (double(S) * top_band + H - double(S) * bottom_band);
   // the centre c: mid-box on the image plane; along f, in front of every point
   const Vec3 c = 0.5 * (lo_r + hi_r) * r + 0.5 * (lo_u + hi_u) * u + (lo_f - 2 * R) * f;
   const Vec3 eye = c;  // rays start on a plane in front of everything
@@ -106,6 +132,9 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
                             std::numeric_limits<double>::infinity());
   std::vector<float> shade(depth.size(), 0.0f);
   std::vector<std::uint8_t> on_stripe(depth.size(), 0);
+  std::vector<float> param(style.colouring == Colouring::stripe ? 0 : depth.size(), 0.0f);
+  double z_lo = std::numeric_limits<double>::infinity(), z_hi = -z_lo;
+  for (const auto& x : X) z_lo = std::min(z_lo, x.z()), z_hi = std::max(z_hi, x.z());
 
   // vertex tangents (central differences), blended along each segment for smooth shading
   std::vector<Vec3> vtan(n);
@@ -123,14 +152,14 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
     // the segment's screen box, grown by the radius
     const double ax = (a - c).dot(r) * scale, ay = (a - c).dot(u) * scale;
     const double bx = (b - c).dot(r) * scale, by = (b - c).dot(u) * scale;
-    const double pad = R * scale + 1;
-    const int x0 = std::max(0, int(std::floor(0.5 * W + std::min(ax, bx) - pad)));
-    const int x1 = std::min(W - 1, int(std::ceil(0.5 * W + std::max(ax, bx) + pad)));
-    const int y0 = std::max(0, int(std::floor(0.5 * H - std::max(ay, by) - pad)));
-    const int y1 = std::min(H - 1, int(std::ceil(0.5 * H - std::min(ay, by) + pad)));
+    const double pad_px = R * scale + 1;
+    const int x0 = std::max(0, int(std::floor(ox + std::min(ax, bx) - pad_px)));
+    const int x1 = std::min(W - 1, int(std::ceil(ox + std::max(ax, bx) + pad_px)));
+    const int y0 = std::max(0, int(std::floor(oy - std::max(ay, by) - pad_px)));
+    const int y1 = std::min(H - 1, int(std::ceil(oy - std::min(ay, by) + pad_px)));
     for (int py = y0; py <= y1; ++py) {
       for (int px = x0; px <= x1; ++px) {
-        const double sx = (px + 0.5 - 0.5 * W) / scale, sy = (0.5 * H - (py + 0.5)) / scale;
+        const double sx = (px + 0.5 - ox) / scale, sy = (oy - (py + 0.5)) / scale;
         const Vec3 ro = eye + sx * r + sy * u;
         const Hit hit = ray_capsule(ro, f, a, b, R);
         const std::size_t idx = std::size_t(py) * std::size_t(W) + std::size_t(px);
@@ -152,6 +181,10 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
         // shade with the same ⟂ normal (Phong-like smoothing across the joints)
         const Vec3 ns = np.norm() > 1e-12 ? Vec3(np.normalized()) : nrm;
         shade[idx] = float(style.ambient + (1 - style.ambient) * std::max(0.0, ns.dot(light)));
+        if (style.colouring == Colouring::along)
+          param[idx] = float((double(k) + hit.h) / double(n));
+        else if (style.colouring == Colouring::height)
+          param[idx] = z_hi > z_lo ? float((axis.z() - z_lo) / (z_hi - z_lo)) : 0.5f;
       }
     }
   }
@@ -178,6 +211,12 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
       if (edge[i]) shade[i] *= float(style.outline_darken);
   }
 
+  // depth cue: the nearest surface as shaded, the farthest blended depth_cue toward the background
+  double d_lo = std::numeric_limits<double>::infinity(), d_hi = -d_lo;
+  for (const double d : depth)
+    if (std::isfinite(d)) d_lo = std::min(d_lo, d), d_hi = std::max(d_hi, d);
+  const double d_span = d_hi > d_lo ? d_hi - d_lo : 1;
+
   // shade and average S×S blocks
   Image img(width, height, style.background);
   for (int y = 0; y < height; ++y) {
@@ -188,16 +227,48 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
           const std::size_t idx = std::size_t(y * S + j) * std::size_t(W) + std::size_t(x * S + i);
           Rgb col = style.background;
           double s = 1;
+          double fog = 0;
           if (std::isfinite(depth[idx])) {
-            col = on_stripe[idx] ? style.stripe : style.tube;
+            if (style.colouring == Colouring::stripe) {
+              col = on_stripe[idx] ? style.stripe : style.tube;
+            } else {
+              col = colour_map(param[idx]);
+              if (on_stripe[idx])
+                col = {to_byte(0.55 * col.r), to_byte(0.55 * col.g), to_byte(0.55 * col.b)};
+            }
             s = shade[idx];
+            fog = style.depth_cue * (depth[idx] - d_lo) / d_span;
           }
-          acc[0] += s * col.r, acc[1] += s * col.g, acc[2] += s * col.b;
+          const Rgb& bg = style.background;
+          acc[0] += (1 - fog) * s * col.r + fog * bg.r;
+          acc[1] += (1 - fog) * s * col.g + fog * bg.g;
+          acc[2] += (1 - fog) * s * col.b + fog * bg.b;
         }
       }
       const double w = 1.0 / double(S * S);
       img.set(x, y, {to_byte(w * acc[0]), to_byte(w * acc[1]), to_byte(w * acc[2])});
     }
+  }
+
+  // labels at the top left, the scale bar at the bottom left (final pixels)
+  const int mx = int(std::lround(margin_px / S));
+  for (std::size_t i = 0; i < style.labels.size(); ++i)
+    draw_text(img, mx, mx + int(i) * line_h, style.labels[i], fs, style.ink);
+  if (style.scale_bar) {
+    const double px_per_unit = scale / S;
+    double len = style.scale_bar_length;
+    if (!(len > 0)) {  // 1, 2 or 5 × 10^k, the largest not above a quarter of the width
+      const double most = 0.25 * width / px_per_unit;
+      const double p10 = std::pow(10.0, std::floor(std::log10(most)));
+      len = most >= 5 * p10 ? 5 * p10 : most >= 2 * p10 ? 2 * p10 : p10;
+    }
+    const int bar = int(std::lround(len * px_per_unit)), thick = 2 * fs;
+    const int yb = height - mx - thick;
+    for (int y = std::max(0, yb); y < yb + thick && y < height; ++y)
+      for (int x = mx; x < mx + bar && x < width; ++x) img.set(x, y, style.ink);
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g Å", len);
+    draw_text(img, mx + bar + 3 * fs, yb + thick - kGlyphH * fs, buf, fs, style.ink);
   }
   return img;
 }

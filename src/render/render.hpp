@@ -29,7 +29,13 @@ View standard_view(const std::string& name);
 /// The names standard_view accepts, in a fixed order.
 std::vector<std::string> standard_view_names();
 
+/// What colours the tube's body: one colour with the D¹ stripe in a second; or a colour map
+/// along the rod (point index: start blue → end red) or of the lab height z, with the stripe a
+/// darker shade of the body.
+enum class Colouring { stripe, along, height };
+
 struct Style {
+  Colouring colouring = Colouring::stripe;
   Rgb background{255, 255, 255};
   Rgb tube{60, 105, 200};    ///< body colour (blue: b > r)
   Rgb stripe{240, 170, 30};  ///< stripe colour (orange: r > b)
@@ -40,6 +46,12 @@ struct Style {
                                  ///< occlusion boundaries (1: no outlines)
   int supersample = 3;           ///< S×S rays per pixel, averaged
   double margin = 0.04;          ///< free border on each side, fraction of the smaller image side
+  double depth_cue = 0.35;  ///< the farthest tube surface is blended this far toward the background
+  std::vector<std::string> labels;  ///< lines written at the top left (a band the rod stays out of)
+  bool scale_bar = false;           ///< a bar of a round length at the bottom left, labelled in Å
+  double scale_bar_length = 0;      ///< its length in X's unit (Å); 0: the round length nearest
+                                    ///< below a quarter of the image width
+  Rgb ink{40, 40, 40};              ///< labels and scale bar
 };
 
 /// Renders the tube of diameter `diameter` (X's length unit) about the closed polygon X with the

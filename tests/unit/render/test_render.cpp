@@ -16,6 +16,7 @@
 
 #include "render/image.hpp"
 #include "render/render.hpp"
+#include "render/text.hpp"
 
 namespace ibrod::render {
 namespace {
@@ -202,6 +203,109 @@ TEST(Render, AGivenFrameSetsScaleAndCentreForEveryPicture) {
   EXPECT_NEAR(b[2] - b[0] + 1, (2 * 50.0 + 20) * scale, 3);
   EXPECT_NEAR(b[0], w - 1 - b[2], 2);
   EXPECT_NEAR(b[1], h - 1 - b[3], 2);
+}
+
+TEST(Text, GlyphsInkOnlyTheirCellsAndWidthsAddUp) {
+  EXPECT_EQ(text_width("", 2), 0);
+  EXPECT_EQ(text_width("8", 1), kGlyphW);
+  EXPECT_EQ(text_width("ΔLk = 6 µs Å", 3), (12 * kGlyphAdvance - 1) * 3);  // UTF-8: 12 glyphs
+  Image img(40, 20, {255, 255, 255});
+  draw_text(img, 3, 4, "18", 2, {0, 0, 0});
+  int inked = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x)
+      if (img.at(x, y) == Rgb{0, 0, 0}) {
+        ++inked;
+        EXPECT_GE(x, 3);
+        EXPECT_LT(x, 3 + text_width("18", 2));
+        EXPECT_GE(y, 4);
+        EXPECT_LT(y, 4 + kGlyphH * 2);
+      }
+  EXPECT_GT(inked, 20 * 4);  // "1" and "8" have 10 + 17 font pixels, each 2×2
+  // an unknown character is a box, not nothing
+  Image unk(10, 10, {255, 255, 255});
+  draw_text(unk, 0, 0, "?", 1, {0, 0, 0});
+  EXPECT_EQ(unk.at(0, 0), (Rgb{0, 0, 0}));
+}
+
+bool is_ink(Rgb p) { return p == Style{}.ink; }
+bool is_colour(Rgb p) { return std::max({p.r, p.g, p.b}) - std::min({p.r, p.g, p.b}) > 30; }
+
+TEST(Render, LabelsAndScaleBarStayOutOfTheRodAndTheBarHasItsStatedLength) {
+  // top view of a ring of 100 Å (tube 20 Å): its picture is 220 Å wide, so a 100 Å bar is
+  // 100/220 of the ring's width in pixels
+  const Ring ring(300, 100.0);
+  Style st;
+  st.labels = {"t = 1.0000 µs", "Wr = 0.000", "ΔLk = 4   Cs = 0.1 M"};
+  st.scale_bar = true;
+  st.scale_bar_length = 100;
+  const int w = 400, h = 400;
+  const Image img = render_rod(ring.X, ring.d1, 20.0, standard_view("top"), w, h, st);
+  int ring_x0 = w, ring_x1 = -1, ring_y0 = h, ring_y1 = -1, ink_top = -1, ink_bottom = h;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      if (is_colour(img.at(x, y)))
+        ring_x0 = std::min(ring_x0, x), ring_x1 = std::max(ring_x1, x),
+        ring_y0 = std::min(ring_y0, y), ring_y1 = std::max(ring_y1, y);
+      if (is_ink(img.at(x, y)) && y < h / 2) ink_top = std::max(ink_top, y);
+      if (is_ink(img.at(x, y)) && y >= h / 2) ink_bottom = std::min(ink_bottom, y);
+    }
+  ASSERT_GE(ink_top, 0) << "no labels";
+  ASSERT_LT(ink_bottom, h) << "no scale bar";
+  EXPECT_LT(ink_top, ring_y0) << "labels overlap the rod";
+  EXPECT_GT(ink_bottom, ring_y1) << "scale bar overlaps the rod";
+  // the bar: the longest run of ink in the bottom rows
+  int bar = 0;
+  for (int y = ink_bottom; y < h; ++y) {
+    int run = 0;
+    for (int x = 0; x < w; ++x) {
+      run = is_ink(img.at(x, y)) ? run + 1 : 0;
+      bar = std::max(bar, run);
+    }
+  }
+  const double ring_px = ring_x1 - ring_x0 + 1;
+  EXPECT_NEAR(bar, ring_px * 100.0 / 220.0, 2.0);
+}
+
+TEST(Render, DepthCueLightensTheFarSideAndColourMapsFollowTheRod) {
+  // a ring seen edge-on from the side: its near and far halves overlap on screen; seen from the
+  // top with a tilt, the far side is lighter with the depth cue than without
+  Ring ring(300, 100.0);
+  for (auto& x : ring.X) x.z() += 0.5 * (x.y() + 5);  // tilted: +y is higher (nearer the eye)
+  Style plain;
+  plain.depth_cue = 0;
+  Style cue;
+  cue.depth_cue = 0.5;
+  const int w = 200, h = 200;
+  const Image a = render_rod(ring.X, ring.d1, 20.0, standard_view("top"), w, h, plain);
+  const Image b = render_rod(ring.X, ring.d1, 20.0, standard_view("top"), w, h, cue);
+  const auto lum = [](Rgb p) { return int(p.r) + p.g + p.b; };
+  // the lowest (far) and highest (near) rows of the ring, at the centre column
+  int y_near = -1, y_far = -1;
+  for (int y = 0; y < h; ++y)
+    if (!is_background(a.at(w / 2, y))) {
+      if (y_near < 0) y_near = y + 3;
+      y_far = y - 3;
+    }
+  ASSERT_GT(y_far, y_near);
+  EXPECT_GT(lum(b.at(w / 2, y_far)), lum(a.at(w / 2, y_far)) + 30);     // far: lighter
+  EXPECT_NEAR(lum(b.at(w / 2, y_near)), lum(a.at(w / 2, y_near)), 30);  // near: about the same
+  // colour along the rod: the start (points just after 0, at +x, y > 0) is blue, the middle
+  // (−x) green
+  Style along;
+  along.colouring = Colouring::along;
+  along.depth_cue = 0;
+  const Ring flat(300, 100.0, 0, kPi / 2);  // D¹ in the plane: no stripe seen from the top
+  const Image c = render_rod(flat.X, flat.d1, 20.0, standard_view("top"), w, h, along);
+  int x_start = -1, x_mid = -1;
+  for (int x = w - 1; x >= 0 && x_start < 0; --x)
+    if (!is_background(c.at(x, h / 2 - 4))) x_start = x - 3;
+  for (int x = 0; x < w && x_mid < 0; ++x)
+    if (!is_background(c.at(x, h / 2))) x_mid = x + 3;
+  const Rgb start = c.at(x_start, h / 2 - 4), mid = c.at(x_mid, h / 2);  // y > 0: k small
+  EXPECT_GT(start.b, start.r + 40);                                      // blue
+  EXPECT_GT(mid.g, mid.r);                                               // green
+  EXPECT_GT(mid.g, mid.b);
 }
 
 TEST(Render, BadInputThrows) {
