@@ -283,7 +283,7 @@ std::vector<fs::path> render_run(const fs::path& dir, const RenderOptions& opt, 
   const bool labels = opt.labels && opt.height >= 120 && opt.width >= 160;
   if (opt.labels && !labels && log)
     std::fprintf(log, "render: no labels or scale bar below 160x120 pixels\n");
-  style.scale_bar = labels;
+  style.scale_bar = style.axis_triad = labels;
 
   std::vector<fs::path> written;
   for (std::size_t j = 0; j < jobs.size(); ++j) {

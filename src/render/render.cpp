@@ -112,7 +112,9 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
   const int fs = std::max(1, int(std::lround(std::min(width, height) / 400.0)));  // font scale
   const int line_h = (kGlyphH + 3) * fs, pad = 3 * fs;
   const int top_band = style.labels.empty() ? 0 : int(style.labels.size()) * line_h + pad;
-  const int bottom_band = style.scale_bar ? (kGlyphH + 3) * fs + pad : 0;
+  const int triad_len = 12 * fs;  // axis triad: arm length in final pixels
+  const int bottom_band = std::max(style.scale_bar ? (kGlyphH + 3) * fs + pad : 0,
+                                   style.axis_triad ? 2 * triad_len + kGlyphH * fs + pad : 0);
   const double avail_h = H - 2 * margin_px - double(S) * (top_band + bottom_band);
   if (!(avail_h > 0))
     throw std::invalid_argument("render_rod: image height " + std::to_string(height) +
@@ -269,6 +271,30 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
     char buf[32];
     std::snprintf(buf, sizeof buf, "%g Å", len);
     draw_text(img, mx + bar + 3 * fs, yb + thick - kGlyphH * fs, buf, fs, style.ink);
+  }
+  if (style.axis_triad) {
+    // the lab axes x, y, z projected on the picture, from a centre at the bottom right; an axis
+    // along the line of sight has a short arm (its letter sits at the centre)
+    const int cx = width - mx - triad_len - kGlyphW * fs, cy = height - mx - triad_len;
+    const Vec3 axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    const char* names[3] = {"x", "y", "z"};
+    for (int a = 0; a < 3; ++a) {
+      const double dx = axes[a].dot(r) * triad_len, dy = -axes[a].dot(u) * triad_len;
+      const int steps = std::max(1, int(std::ceil(std::max(std::abs(dx), std::abs(dy)))));
+      for (int i = 0; i <= steps; ++i) {
+        const int px = cx + int(std::lround(dx * i / steps)),
+                  py = cy + int(std::lround(dy * i / steps));
+        for (int j = 0; j < fs; ++j)
+          for (int k = 0; k < fs; ++k)
+            if (px + j >= 0 && py + k >= 0 && px + j < width && py + k < height)
+              img.set(px + j, py + k, style.ink);
+      }
+      const double len = std::hypot(dx, dy);
+      const double lx = len > 0 ? dx / len : 0, ly = len > 0 ? dy / len : 0;
+      draw_text(img, cx + int(std::lround(dx + lx * 5 * fs)) - (kGlyphW * fs) / 2,
+                cy + int(std::lround(dy + ly * 6 * fs)) - (kGlyphH * fs) / 2, names[a], fs,
+                style.ink);
+    }
   }
   return img;
 }

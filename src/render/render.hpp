@@ -51,7 +51,8 @@ struct Style {
   bool scale_bar = false;           ///< a bar of a round length at the bottom left, labelled in Å
   double scale_bar_length = 0;      ///< its length in X's unit (Å); 0: the round length nearest
                                     ///< below a quarter of the image width
-  Rgb ink{40, 40, 40};              ///< labels and scale bar
+  bool axis_triad = false;          ///< the lab axes x, y, z at the bottom right
+  Rgb ink{40, 40, 40};              ///< labels, scale bar and axis triad
 };
 
 /// Renders the tube of diameter `diameter` (X's length unit) about the closed polygon X with the

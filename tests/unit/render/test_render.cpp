@@ -267,6 +267,33 @@ TEST(Render, LabelsAndScaleBarStayOutOfTheRodAndTheBarHasItsStatedLength) {
   EXPECT_NEAR(bar, ring_px * 100.0 / 220.0, 2.0);
 }
 
+TEST(Render, AxisTriadShowsXRightAndYUpInTheTopViewBelowTheRod) {
+  const Ring ring(300, 100.0);
+  Style st;
+  st.axis_triad = true;
+  const int w = 400, h = 400;
+  const Image img = render_rod(ring.X, ring.d1, 20.0, standard_view("top"), w, h, st);
+  // longest horizontal and vertical runs of ink in the bottom right corner
+  int hx0 = 0, hy = 0, hlen = 0, vx = 0, vy1 = 0, vlen = 0, ring_bottom = 0, ink_top = h;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0, run = 0; x < w; ++x) {
+      if (is_colour(img.at(x, y))) ring_bottom = std::max(ring_bottom, y);
+      run = is_ink(img.at(x, y)) && x > w / 2 ? run + 1 : 0;
+      if (run > 0) ink_top = std::min(ink_top, y);
+      if (run > hlen) hlen = run, hx0 = x - run + 1, hy = y;
+    }
+  for (int x = w / 2; x < w; ++x)
+    for (int y = 0, run = 0; y < h; ++y) {
+      run = is_ink(img.at(x, y)) ? run + 1 : 0;
+      if (run > vlen) vlen = run, vx = x, vy1 = y;
+    }
+  EXPECT_NEAR(hlen, 13, 1);  // the x arm: 12 px plus its start pixel, pointing right
+  EXPECT_NEAR(vlen, 13, 1);  // the y arm, pointing up
+  EXPECT_NEAR(hx0, vx, 1);   // both start at the centre (z points at the eye: no arm)
+  EXPECT_NEAR(hy, vy1, 1);
+  EXPECT_LT(ring_bottom, ink_top) << "the triad overlaps the rod";
+}
+
 TEST(Render, DepthCueLightensTheFarSideAndColourMapsFollowTheRod) {
   // a ring seen edge-on from the side: its near and far halves overlap on screen; seen from the
   // top with a tilt, the far side is lighter with the depth cue than without
