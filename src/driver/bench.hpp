@@ -24,6 +24,9 @@ struct BenchResult {
   /// reference nor a slow decomposition can flatter the ratio
   double fft_ms = 0;
   double diagnostics_ms = 0;  ///< one observe() (output steps only)
+  /// solvent.thermal = true: the whole step of a twin without noise, timed in the same rounds
+  /// (docs/thermal.md: the cost of the noise is step_ms / deterministic_step_ms − 1); else 0
+  double deterministic_step_ms = 0;
   int steps = 0, threads = 0;
   double ratio() const { return step_ms / fft_ms; }
 };

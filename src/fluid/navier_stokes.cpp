@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/philox.hpp"
 #include "core/target_clones.hpp"
 #include "fluid/advection.hpp"
 #include "fluid/fftw_wisdom.hpp"
@@ -212,9 +213,11 @@ void FluidSolver::pass_pencils() {
     const int par = (j * nzh) % 2;
     fftw_complex* slice = base + std::size_t(j) * nzh;
     fftw_execute_dft(as_plan(plan_x_fwd_[par]), slice, slice);
+    if (params_.thermal_kT > 0) add_noise_slice(j);
     solve_slice(j);
     fftw_execute_dft(as_plan(plan_x_bwd_[par]), slice, slice);
   }
+  ++noise_step_;
 }
 
 void FluidSolver::pass_inverse_planes(const PlaneSampler* sampler) {
@@ -294,6 +297,70 @@ IBROD_TARGET_CLONES void solve_row(int len, double gx, double gy, double gxy2, d
 
 }  // namespace
 
+// The thermal random stress of docs/thermal.md, drawn in Fourier space: r̂(k) += ξ̂(k) with
+//   ⟨ξ̂_c(k) ξ̂_c(k)*⟩ = n³ σ²(k),  σ²(k) = 2 kT μ λ(k) / (h³ Δt),  λ = −L̂ = (4/h²) Σ_j sin²(πk_j/n),
+// independent components c and modes, i.e. the unnormalised DFT of a real field whose divergence
+// part is the discrete divergence of a random stress (the projection in the solve removes the
+// rest). Each k draws from Philox4x32-10 keyed by (seed) with the counter (mode index, word,
+// step): the same numbers for any thread count and order. In the k_z = 0 and n/2 planes the half
+// spectrum holds k and −k: k draws with the index of whichever of the two comes first and takes
+// the complex conjugate otherwise (a Hermitian spectrum, i.e. a real field), and a k equal to −k
+// gets a real value of the full variance. k = 0 (λ = 0) gets none: momentum is conserved.
+void FluidSolver::add_noise_slice(int j) {
+  const int n = grid_.n;
+  const int nzh = n / 2 + 1;
+  const double h = grid_.h();
+  // variance of each real and imaginary part: n³ σ²/2 = c λ
+  const double c =
+      params_.thermal_kT * params_.viscosity * double(grid_.size()) / (h * h * h * params_.dt);
+  const double* ls = lap_symbol_.data();
+  const std::uint32_t key0 = std::uint32_t(params_.seed), key1 = std::uint32_t(params_.seed >> 32);
+  const std::uint32_t st0 = std::uint32_t(noise_step_), st1 = std::uint32_t(noise_step_ >> 32);
+  double* r[3] = {reinterpret_cast<double*>(fh_[0]), reinterpret_cast<double*>(fh_[1]),
+                  reinterpret_cast<double*>(fh_[2])};
+  const int nj = (n - j) % n;
+  for (int i = 0; i < n; ++i) {
+    const int ni = (n - i) % n;
+    const double lxy = ls[i] + ls[j];
+    const std::size_t o = 2 * (std::size_t(i) * plane_c_ + std::size_t(j) * nzh);
+    for (int kz = 0; kz < nzh; ++kz) {
+      const double lam = lxy + ls[kz];
+      if (lam == 0.0) continue;  // k = 0
+      // which of k, −k draws, and whether k is its own conjugate (a real value)
+      int si = i, sj = j;
+      double sign = 1.0;
+      bool real_only = false;
+      if (kz == 0 || 2 * kz == n) {
+        if (ni == i && nj == j) {
+          real_only = true;
+        } else if (std::size_t(ni) * n + nj < std::size_t(i) * n + j) {
+          si = ni;
+          sj = nj;
+          sign = -1.0;
+        }
+      }
+      const std::uint32_t mode = std::uint32_t((std::size_t(si) * n + sj) * nzh + kz);
+      const Philox4x32 w0 = philox4x32_10({mode, 0u, st0, st1}, key0, key1);
+      const Philox4x32 w1 = philox4x32_10({mode, 1u, st0, st1}, key0, key1);
+      double re[3], im[3];
+      box_muller(w0[0], w0[1], re[0], im[0]);
+      box_muller(w0[2], w0[3], re[1], im[1]);
+      box_muller(w1[0], w1[1], re[2], im[2]);
+      const std::size_t t = o + 2 * std::size_t(kz);
+      if (real_only) {
+        const double a = std::sqrt(2.0 * c * lam);
+        for (int d = 0; d < 3; ++d) r[d][t] += a * re[d];
+      } else {
+        const double a = std::sqrt(c * lam);
+        for (int d = 0; d < 3; ++d) {
+          r[d][t] += a * re[d];
+          r[d][t + 1] += sign * a * im[d];
+        }
+      }
+    }
+  }
+}
+
 void FluidSolver::solve_slice(int j) {
   const int n = grid_.n;
   const double inertia = params_.density / params_.dt;          // ρ/Δt, g Å⁻³ s⁻¹
@@ -307,6 +374,9 @@ void FluidSolver::solve_slice(int j) {
   double* r1 = reinterpret_cast<double*>(fh_[1]);
   double* r2 = reinterpret_cast<double*>(fh_[2]);
   const double gy = gs[j];
+  if (j == 0)  // the uniform body force: the k = 0 entry of the unnormalised DFT is n³ f
+    for (int c = 0; c < 3; ++c)
+      (c == 0 ? r0 : c == 1 ? r1 : r2)[0] += double(grid_.size()) * mean_force_[c];
   for (int i = 0; i < n; ++i) {
     const double gx = gs[i];
     const std::size_t o = 2 * (std::size_t(i) * plane_c_ + std::size_t(j) * nzh);
