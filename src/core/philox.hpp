@@ -7,7 +7,6 @@
 // draw keyed by (seed, step, index) is the same in any thread, in any order, after any resume.
 // Used by the thermal noise of the fluid (docs/thermal.md).
 #include <array>
-#include <cmath>
 #include <cstdint>
 
 namespace ibrod {
@@ -32,15 +31,20 @@ inline Philox4x32 philox4x32_10(Philox4x32 ctr, std::uint32_t k0, std::uint32_t 
   return ctr;
 }
 
-/// A uniform number in (0, 1) from 32 random bits (never 0: safe for a logarithm).
-inline double uniform_open01(std::uint32_t x) { return (double(x) + 0.5) * 0x1p-32; }
-
-/// Two independent standard normal numbers from two 32-bit words (Box–Muller).
-inline void box_muller(std::uint32_t a, std::uint32_t b, double& z0, double& z1) {
-  const double r = std::sqrt(-2.0 * std::log(uniform_open01(a)));
-  const double t = 6.283185307179586 * uniform_open01(b);
-  z0 = r * std::cos(t);
-  z1 = r * std::sin(t);
+/// Six independent random numbers of mean 0 and variance 1 (uniform on (−√3, √3), to within
+/// 2⁻²¹) from one Philox output: the four words' top 21 bits and two 22-bit numbers made of their
+/// low 11 bits. The thermal noise needs only mean and variance per mode (docs/thermal.md: every
+/// velocity is a sum over many modes, Gaussian by the central limit theorem), and no logarithm or
+/// sine keeps it cheap.
+inline void unit_variance6(const Philox4x32& w, double z[6]) {
+  constexpr double kSqrt12 = 3.4641016151377544;
+  constexpr double k21 = 0x1p-21, k22 = 0x1p-22;
+  z[0] = kSqrt12 * ((double(w[0] >> 11) + 0.5) * k21 - 0.5);
+  z[1] = kSqrt12 * ((double(w[1] >> 11) + 0.5) * k21 - 0.5);
+  z[2] = kSqrt12 * ((double(w[2] >> 11) + 0.5) * k21 - 0.5);
+  z[3] = kSqrt12 * ((double(w[3] >> 11) + 0.5) * k21 - 0.5);
+  z[4] = kSqrt12 * ((double((w[0] & 0x7ffu) | ((w[1] & 0x7ffu) << 11)) + 0.5) * k22 - 0.5);
+  z[5] = kSqrt12 * ((double((w[2] & 0x7ffu) | ((w[3] & 0x7ffu) << 11)) + 0.5) * k22 - 0.5);
 }
 
 }  // namespace ibrod

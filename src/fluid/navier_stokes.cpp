@@ -297,15 +297,42 @@ IBROD_TARGET_CLONES void solve_row(int len, double gx, double gy, double gxy2, d
 
 }  // namespace
 
+namespace {
+
+// One x-row of the thermal noise (add_noise_slice) for k_z in [kz0, kz1), where k and −k are both
+// stored (0 < k_z < n/2): r̂_c(k) += √(cλ) (z_c + i z_{c+3}), z the six unit-variance numbers of
+// the Philox output for the counter (mode0 + k_z, 0, step). Branch-free: vectorises.
+IBROD_TARGET_CLONES void noise_row(int kz0, int kz1, std::uint32_t mode0, double lxy,
+                                   const double* lz, double c, std::uint32_t st0, std::uint32_t st1,
+                                   std::uint32_t key0, std::uint32_t key1, double* r0, double* r1,
+                                   double* r2) {
+#pragma omp simd
+  for (int kz = kz0; kz < kz1; ++kz) {
+    const Philox4x32 w = philox4x32_10({mode0 + std::uint32_t(kz), 0u, st0, st1}, key0, key1);
+    double z[6];
+    unit_variance6(w, z);
+    const double a = std::sqrt(c * (lxy + lz[kz]));
+    r0[2 * kz] += a * z[0];
+    r1[2 * kz] += a * z[1];
+    r2[2 * kz] += a * z[2];
+    r0[2 * kz + 1] += a * z[3];
+    r1[2 * kz + 1] += a * z[4];
+    r2[2 * kz + 1] += a * z[5];
+  }
+}
+
+}  // namespace
+
 // The thermal random stress of docs/thermal.md, drawn in Fourier space: r̂(k) += ξ̂(k) with
 //   ⟨ξ̂_c(k) ξ̂_c(k)*⟩ = n³ σ²(k),  σ²(k) = 2 kT μ λ(k) / (h³ Δt),  λ = −L̂ = (4/h²) Σ_j sin²(πk_j/n),
 // independent components c and modes, i.e. the unnormalised DFT of a real field whose divergence
 // part is the discrete divergence of a random stress (the projection in the solve removes the
-// rest). Each k draws from Philox4x32-10 keyed by (seed) with the counter (mode index, word,
-// step): the same numbers for any thread count and order. In the k_z = 0 and n/2 planes the half
-// spectrum holds k and −k: k draws with the index of whichever of the two comes first and takes
-// the complex conjugate otherwise (a Hermitian spectrum, i.e. a real field), and a k equal to −k
-// gets a real value of the full variance. k = 0 (λ = 0) gets none: momentum is conserved.
+// rest). Each k takes six unit-variance numbers (real and imaginary parts of three components)
+// from one Philox4x32-10 output keyed by the seed, with the counter (mode index, 0, step): the
+// same numbers for any thread count and order. In the k_z = 0 and n/2 planes the half spectrum
+// holds k and −k: k draws with the index of whichever of the two comes first and takes the
+// complex conjugate otherwise (a Hermitian spectrum, i.e. a real field), and a k equal to −k gets
+// a real value of the full variance. k = 0 (λ = 0) gets none: momentum is conserved.
 void FluidSolver::add_noise_slice(int j) {
   const int n = grid_.n;
   const int nzh = n / 2 + 1;
@@ -323,42 +350,35 @@ void FluidSolver::add_noise_slice(int j) {
     const int ni = (n - i) % n;
     const double lxy = ls[i] + ls[j];
     const std::size_t o = 2 * (std::size_t(i) * plane_c_ + std::size_t(j) * nzh);
-    for (int kz = 0; kz < nzh; ++kz) {
+    const std::uint32_t row = std::uint32_t((std::size_t(i) * n + j) * nzh);
+    noise_row(1, n / 2, row, lxy, ls, c, st0, st1, key0, key1, r[0] + o, r[1] + o, r[2] + o);
+    for (const int kz : {0, n / 2}) {  // the Hermitian planes
       const double lam = lxy + ls[kz];
       if (lam == 0.0) continue;  // k = 0
       // which of k, −k draws, and whether k is its own conjugate (a real value)
-      int si = i, sj = j;
+      std::uint32_t mode = row + std::uint32_t(kz);
       double sign = 1.0;
-      bool real_only = false;
-      if (kz == 0 || 2 * kz == n) {
-        if (ni == i && nj == j) {
-          real_only = true;
-        } else if (std::size_t(ni) * n + nj < std::size_t(i) * n + j) {
-          si = ni;
-          sj = nj;
-          sign = -1.0;
-        }
+      const bool real_only = ni == i && nj == j;
+      if (!real_only && std::size_t(ni) * n + nj < std::size_t(i) * n + j) {
+        mode = std::uint32_t((std::size_t(ni) * n + nj) * nzh + kz);
+        sign = -1.0;
       }
-      const std::uint32_t mode = std::uint32_t((std::size_t(si) * n + sj) * nzh + kz);
-      const Philox4x32 w0 = philox4x32_10({mode, 0u, st0, st1}, key0, key1);
-      const Philox4x32 w1 = philox4x32_10({mode, 1u, st0, st1}, key0, key1);
-      double re[3], im[3];
-      box_muller(w0[0], w0[1], re[0], im[0]);
-      box_muller(w0[2], w0[3], re[1], im[1]);
-      box_muller(w1[0], w1[1], re[2], im[2]);
+      double z[6];
+      unit_variance6(philox4x32_10({mode, 0u, st0, st1}, key0, key1), z);
       const std::size_t t = o + 2 * std::size_t(kz);
-      if (real_only) {
-        const double a = std::sqrt(2.0 * c * lam);
-        for (int d = 0; d < 3; ++d) r[d][t] += a * re[d];
-      } else {
-        const double a = std::sqrt(c * lam);
-        for (int d = 0; d < 3; ++d) {
-          r[d][t] += a * re[d];
-          r[d][t + 1] += sign * a * im[d];
-        }
+      const double a = std::sqrt((real_only ? 2.0 : 1.0) * c * lam);
+      for (int d = 0; d < 3; ++d) {
+        r[d][t] += a * z[d];
+        if (!real_only) r[d][t + 1] += sign * a * z[d + 3];
       }
     }
   }
+}
+
+void FluidSolver::run_noise_only() {
+  if (!(params_.thermal_kT > 0)) return;
+#pragma omp parallel for num_threads(threads_) schedule(static)
+  for (int j = 0; j < grid_.n; ++j) add_noise_slice(j);
 }
 
 void FluidSolver::solve_slice(int j) {

@@ -153,6 +153,10 @@ class FluidSolver {
   /// per y-slice, inverse 2-D plane FFTs, threaded over planes and slices) with nothing else:
   /// the step's own FFT time. Clobbers force and velocity; not part of the physics.
   void run_split_ffts_only();
+  /// Benchmark aid: the thermal noise of one step alone (add_noise_slice over all y-slices,
+  /// threaded like the step) into the spectrum buffer, which it clobbers; the noise counter is
+  /// left as it was. Nothing without FluidParams::thermal_kT > 0.
+  void run_noise_only();
 
  private:
   GridSpec grid_;
