@@ -11,6 +11,7 @@
 #include "core/units.hpp"
 #include "integrate/implicit.hpp"
 #include "integrate/stepper.hpp"
+#include "sim/simulation.hpp"
 
 namespace ibrod::integrate {
 namespace {
@@ -101,6 +102,44 @@ TEST(External, PulledRingMovesAlongTheForceLinearly) {
 
 namespace ibrod::integrate {
 namespace {
+
+// The implicit scheme (Stokes limit) picks the external force up through compute_forces: its
+// pulled ring moves like the explicit scheme's, whose fluid has inertia. Measured: the implicit
+// velocity is 4.7 % higher for this 60-point ring (1.1 % for the 100-point ring of
+// docs/thermal.md); not explained yet (docs/thermal.md), hence 8 %: a force missing from either
+// scheme, or counted twice, would be O(1).
+TEST(External, ImplicitSchemePullsTheRingAtTheExplicitVelocity) {
+  config::Config c;
+  c.grid_n = 16;
+  c.grid_box_A = 200;
+  c.rod_base_pairs = 60;
+  c.rod_excess_link = 0;
+  c.rod_perturbation = {0.0};
+  c.run_threads = 1;
+  c.run_fftw_measure = false;
+  c.external_force_pN = {1.0, 0, 0};
+  c.time_scheme = "implicit";
+  c.time_dt_ns = 1.0;
+  c.time_t_end_us = 0.02;
+  sim::Simulation s(config::to_params(c));
+  const Vec3 c0 = centroid(s.rod().X);
+  s.step();  // the flow develops within the first step of the explicit scheme: skip it in both
+  const Vec3 c1 = centroid(s.rod().X);
+  const double t1 = s.time();
+  while (!s.at_end()) s.step();
+  const double v_implicit = (centroid(s.rod().X) - c1)[0] / (s.time() - t1);
+  (void)c0;
+  // the explicit scheme's steady velocity, after 10 steps of start-up
+  const sim::SimParams p = ring_params({1.0, 0, 0}, {0, 0, 0});
+  rod::RodState r = rod::twisted_circle(p.stepper.rod, p.circle);
+  Stepper st(p.stepper);
+  for (int i = 0; i < 10; ++i) st.step(r);
+  const Vec3 e0 = centroid(r.X);
+  for (int i = 0; i < 100; ++i) st.step(r);
+  const double v_explicit = (centroid(r.X) - e0)[0] / (100 * p.dt);
+  std::printf("pulled ring: v_implicit / v_explicit = %.4f\n", v_implicit / v_explicit);
+  EXPECT_NEAR(v_implicit / v_explicit, 1.0, 0.08);
+}
 
 // The stochastic drift kT ∂_X·M of the overdamped limit, which the thermal scheme does not add
 // (docs/thermal.md): measured on a 60-point ring at 16³ by central differences of the Stokes
