@@ -63,6 +63,10 @@ struct Config {
   double solvent_density_g_cm3 = 1.0;
   double solvent_temperature_K = 300.0;
   bool solvent_advection = true;  ///< include the nonlinear advection term
+  bool solvent_thermal = false;   ///< thermal fluctuations (random stress; docs/thermal.md)
+  // [external] (docs/thermal.md)
+  std::vector<double> external_force_pN{0.0, 0.0, 0.0};      ///< total force on the rod, pN
+  std::vector<double> external_torque_pN_nm{0.0, 0.0, 0.0};  ///< torque about its centre, pN·nm
   // [electrostatics]
   bool electrostatics_enabled = true;
   double electrostatics_charge_e = 0.48;    ///< charge per base pair, e
@@ -83,6 +87,7 @@ struct Config {
   // [run]
   int run_threads = 0;           ///< 0: OpenMP default (OMP_NUM_THREADS or all cores)
   bool run_fftw_measure = true;  ///< FFTW_MEASURE plans (false: FFTW_ESTIMATE)
+  std::int64_t run_seed = 1;     ///< run.seed: key of the thermal noise
 
   Config();
 };

@@ -44,6 +44,10 @@ void validate(const Config& c) {
   if (c.time_scheme == "implicit" && c.time_dt_min_ns > c.time_dt_ns)
     bad("time.dt_min_ns", fmt(c.time_dt_min_ns),
         "at most time.dt_ns = " + fmt(c.time_dt_ns) + " ns (the implicit scheme's largest step)");
+  if (c.solvent_thermal && c.time_scheme == "implicit")
+    bad("solvent.thermal", "true",
+        "false with time.scheme = \"implicit\" (thermal noise is implemented for the explicit "
+        "scheme only; docs/thermal.md)");
   if (c.time_dt_ns * 1e-3 > c.time_t_end_us)
     bad("time.t_end_us", fmt(c.time_t_end_us),
         "at least one time step (time.dt_ns = " + fmt(c.time_dt_ns) + " ns)");
@@ -112,6 +116,13 @@ sim::SimParams to_params(const Config& c) {
   s.steric.diameter = c.steric_diameter_A;
   s.steric.stiffness = c.steric_stiffness_kT_A2 * p.kT;
   s.steric.ds = s.rod.ds;
+  // docs/thermal.md: the random stress at kT, keyed by run.seed; the external load
+  s.fluid.thermal_kT = c.solvent_thermal ? p.kT : 0.0;
+  s.fluid.seed = std::uint64_t(c.run_seed);
+  for (int d = 0; d < 3; ++d) {
+    s.external_force[d] = c.external_force_pN[d] * pN;
+    s.external_torque[d] = c.external_torque_pN_nm[d] * pN * nm;
+  }
   s.threads = c.run_threads;
   s.plan_measure = c.run_fftw_measure;
   p.circle.excess_link = c.rod_excess_link;

@@ -147,6 +147,21 @@ Key real_array(std::string name, std::vector<double> Config::*m, double max_abs,
 
 const double inf = std::numeric_limits<double>::max();
 
+// A vector of three numbers, each |value| <= max_abs (external.force_pN, external.torque_pN_nm).
+Key vec3_key(std::string name, std::vector<double> Config::*m, double max_abs, std::string help) {
+  Key k = real_array(name, m, max_abs, help);
+  const auto set = k.set;
+  k.set = [=](Config& c, const toml::node& n) {
+    const toml::array* a = n.as_array();
+    if (!a || a->size() != 3)
+      bad(name, show(n),
+          "an array of three numbers [x, y, z] with |value| <= " + fmt(max_abs) + " (" + help +
+              ")");
+    set(c, n);
+  };
+  return k;
+}
+
 // A dimensional parameter of the model, within kDecades decades of its reference value (MODEL §1,
 // the default) either way. Why 20: a step forms products and quotients of at most about ten such
 // parameters (e.g. the kinetic energy ρ u² h³ with u ~ a Δt / (ρ Δs² h³)), so every intermediate
@@ -323,6 +338,14 @@ const std::vector<Key>& schema() {
                "temperature for kT, K"),
       boolean("solvent.advection", &Config::solvent_advection,
               "include the nonlinear advection term ρ u·∇u"),
+      boolean("solvent.thermal", &Config::solvent_thermal,
+              "thermal fluctuations at solvent.temperature_K: a random stress in the fluid, keyed "
+              "by run.seed (explicit scheme; docs/thermal.md)"),
+      vec3_key("external.force_pN", &Config::external_force_pN, 1e6,
+               "total external force on the rod, spread evenly over its points, pN"),
+      vec3_key("external.torque_pN_nm", &Config::external_torque_pN_nm, 1e8,
+               "external torque on the rod about its centroid (as point forces of a rigid "
+               "rotation), pN·nm"),
       boolean("electrostatics.enabled", &Config::electrostatics_enabled,
               "Debye–Hückel repulsion between rod points"),
       physical("electrostatics.charge_e", &Config::electrostatics_charge_e, 0.48, true,
@@ -350,6 +373,8 @@ const std::vector<Key>& schema() {
               "threads (0: OMP_NUM_THREADS or all cores)"),
       boolean("run.fftw_measure", &Config::run_fftw_measure,
               "time FFTW plans at start (faster steps) instead of estimating them"),
+      integer("run.seed", &Config::run_seed, 0, std::numeric_limits<std::int64_t>::max(),
+              "seed of the thermal noise (solvent.thermal): the same seed, the same trajectory"),
   };
   return keys;
 }

@@ -21,6 +21,7 @@ inline constexpr double ns = 1e-9 * second;
 inline constexpr double us = 1e-6 * second;
 // derived CGS units
 inline constexpr double dyn = gram * cm / (second * second);  ///< 1e8 g Å s⁻²
+inline constexpr double pN = 1e-7 * dyn;                      ///< piconewton, 10 g Å s⁻²
 inline constexpr double erg = dyn * cm;                       ///< 1e16 g Å² s⁻²
 inline constexpr double erg_cm = erg * cm;             ///< bending modulus unit, 1e24 g Å³ s⁻²
 inline constexpr double poise = gram / (cm * second);  ///< 1e-8 g Å⁻¹ s⁻¹

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <limits>
+#include <memory>
 
 #include "integrate/stepper.hpp"
 #include "sim/simulation.hpp"
@@ -49,12 +50,31 @@ BenchResult bench(const Config& c, int steps) {
   std::fill(best_phase, best_phase + kPhases, inf);
   double best_step = inf, best_fft = inf, best_split = inf;
   const int per_round = std::max(1, steps / kRounds);
+  // with noise, a deterministic twin timed in the same rounds (the noise's cost, one run)
+  std::unique_ptr<sim::Simulation> twin;
+  if (c.solvent_thermal) {
+    Config d = c;
+    d.solvent_thermal = false;
+    twin = std::make_unique<sim::Simulation>(to_params(d));
+    for (int i = 0; i < std::min(steps, 10); ++i) twin->step();
+  }
+  double best_twin = inf, best_noise = inf;
 
   for (int round = 0; round < kRounds; ++round) {
     // 1. whole steps, exactly as a run does them
     auto t = Clock::now();
     for (int i = 0; i < per_round; ++i) s.step();
     best_step = std::min(best_step, ms_since(t) / per_round);
+    if (twin) {
+      // the deterministic twin's steps, and the noise of one step alone (the spectrum buffer is
+      // scratch between steps)
+      t = Clock::now();
+      for (int i = 0; i < per_round; ++i) twin->step();
+      best_twin = std::min(best_twin, ms_since(t) / per_round);
+      t = Clock::now();
+      for (int i = 0; i < per_round; ++i) fl.run_noise_only();
+      best_noise = std::min(best_noise, ms_since(t) / per_round);
+    }
 
     // 2. the same steps, timed phase by phase (Stepper::step with a phase clock; the fluid
     // half is split into the three passes of FluidSolver::step)
@@ -90,6 +110,10 @@ BenchResult bench(const Config& c, int steps) {
   r.split_fft_ms = best_split;
   r.fft_ms = std::min(best_fft, best_split);
   r.fluid_solve_ms = best_phase[3] + best_phase[4] + best_phase[5];
+  if (twin) {
+    r.deterministic_step_ms = best_twin;
+    r.noise_ms = best_noise;
+  }
 
   // Diagnostics (output steps only).
   const int reps = std::max(1, std::min(steps / 10, 20));
@@ -125,6 +149,14 @@ void print_bench(const Config& c, const BenchResult& r, std::FILE* out) {
   std::fprintf(out, "%-22s %10.4f   (per output step, every %lld steps: %.4f ms/step)\n",
                "diagnostics", r.diagnostics_ms, static_cast<long long>(c.output_every_steps),
                r.diagnostics_ms / double(std::max<long long>(1, c.output_every_steps)));
+  if (r.deterministic_step_ms > 0) {
+    std::fprintf(out, "%-22s %10.4f   (the same configuration without solvent.thermal)\n",
+                 "deterministic step", r.deterministic_step_ms);
+    std::fprintf(out, "%-22s %10.4f   (the random stress of one step alone)\n", "thermal noise",
+                 r.noise_ms);
+    std::fprintf(out, "noise_cost_ratio=%.4f   (thermal noise / deterministic step)\n",
+                 r.noise_ms / r.deterministic_step_ms);
+  }
   std::fprintf(out, "ratio_step_to_fft=%.4f\n", r.ratio());
 }
 

@@ -24,6 +24,11 @@ struct BenchResult {
   /// reference nor a slow decomposition can flatter the ratio
   double fft_ms = 0;
   double diagnostics_ms = 0;  ///< one observe() (output steps only)
+  /// solvent.thermal = true: the whole step of a twin without noise, timed in the same rounds
+  /// (docs/thermal.md); else 0
+  double deterministic_step_ms = 0;
+  /// solvent.thermal = true: the random stress of one step alone (FluidSolver::run_noise_only)
+  double noise_ms = 0;
   int steps = 0, threads = 0;
   double ratio() const { return step_ms / fft_ms; }
 };

@@ -288,10 +288,13 @@ RunResult Run::State::loop(const SignalGuard& signals) {
   loop_start = Clock::now();
   start_step = s.step_count();
   const double ds = c.rod_rise_A;
+  // docs/thermal.md: with noise a segment's thermal stretch alone may pass 50 %
+  const double tol =
+      sim::spacing_tolerance(s.params().stepper.rod, s.params().stepper.fluid.thermal_kT);
   try {
     ensure_space();
     if (result.resumed_from < 0) {
-      if (const std::string bad = sim::rod_problem(s.rod(), ds); !bad.empty())
+      if (const std::string bad = sim::rod_problem(s.rod(), ds, tol); !bad.empty())
         blow_up("the initial state is not sane: " + bad);
       last_row = observe_checked();
       result.initial = meta.initial = last_row;
@@ -330,7 +333,7 @@ RunResult Run::State::loop(const SignalGuard& signals) {
         return result;
       }
       s.step();
-      if (const std::string bad = sim::rod_problem(s.rod(), ds); !bad.empty()) blow_up(bad);
+      if (const std::string bad = sim::rod_problem(s.rod(), ds, tol); !bad.empty()) blow_up(bad);
       const bool output_step = s.output_due();
       if (output_step) {
         last_row = observe_checked();

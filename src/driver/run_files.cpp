@@ -56,6 +56,10 @@ std::string summary_json(const config::Config& c, const RunResult& r, const Chec
   j["time_us"] = time_without_noise(r.time_us);
   j["stop_reason"] = stop_reason;
   j["excess_link"] = c.rod_excess_link;
+  // docs/thermal.md: whether the run had thermal noise, at which temperature, with which seed
+  j["thermal"] = c.solvent_thermal;
+  j["temperature_K"] = c.solvent_temperature_K;
+  j["seed"] = c.run_seed;
   j["link_drift"] = r.final.link - r.initial.link;
   j["max_link_drift"] = meta.max_link_drift;
   j["self_passage_warning"] = meta.self_passage_warning;

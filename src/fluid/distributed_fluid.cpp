@@ -66,6 +66,9 @@ DistributedFluid::DistributedFluid(const GridSpec& grid, const FluidParams& para
   MPI_Comm_size(MPI_COMM_WORLD, &ranks_);
   // The same checks as FluidSolver; every rank sees the same arguments, so all throw alike.
   detail::check_fluid_args("DistributedFluid", grid, params, threads);
+  if (params.thermal_kT > 0)
+    throw std::invalid_argument(
+        "DistributedFluid: thermal noise (solvent.thermal) runs on one process only");
   if (grid.n % ranks_ != 0)
     throw std::invalid_argument("DistributedFluid: the grid of n = " + std::to_string(grid.n) +
                                 " x-planes cannot be split evenly over " + std::to_string(ranks_) +

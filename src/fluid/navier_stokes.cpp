@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/philox.hpp"
 #include "core/target_clones.hpp"
 #include "fluid/advection.hpp"
 #include "fluid/fftw_wisdom.hpp"
@@ -212,9 +213,11 @@ void FluidSolver::pass_pencils() {
     const int par = (j * nzh) % 2;
     fftw_complex* slice = base + std::size_t(j) * nzh;
     fftw_execute_dft(as_plan(plan_x_fwd_[par]), slice, slice);
+    if (params_.thermal_kT > 0) add_noise_slice(j);
     solve_slice(j);
     fftw_execute_dft(as_plan(plan_x_bwd_[par]), slice, slice);
   }
+  ++noise_step_;
 }
 
 void FluidSolver::pass_inverse_planes(const PlaneSampler* sampler) {
@@ -294,6 +297,90 @@ IBROD_TARGET_CLONES void solve_row(int len, double gx, double gy, double gxy2, d
 
 }  // namespace
 
+namespace {
+
+// One x-row of the thermal noise (add_noise_slice) for k_z in [kz0, kz1), where k and −k are both
+// stored (0 < k_z < n/2): r̂_c(k) += √(cλ) (z_c + i z_{c+3}), z the six unit-variance numbers of
+// the Philox output for the counter (mode0 + k_z, 0, step). Branch-free: vectorises.
+IBROD_TARGET_CLONES void noise_row(int kz0, int kz1, std::uint32_t mode0, double lxy,
+                                   const double* lz, double c, std::uint32_t st0, std::uint32_t st1,
+                                   std::uint32_t key0, std::uint32_t key1, double* r0, double* r1,
+                                   double* r2) {
+#pragma omp simd
+  for (int kz = kz0; kz < kz1; ++kz) {
+    const Philox4x32 w = philox4x32_10({mode0 + std::uint32_t(kz), 0u, st0, st1}, key0, key1);
+    double z[6];
+    unit_variance6(w, z);
+    const double a = std::sqrt(c * (lxy + lz[kz]));
+    r0[2 * kz] += a * z[0];
+    r1[2 * kz] += a * z[1];
+    r2[2 * kz] += a * z[2];
+    r0[2 * kz + 1] += a * z[3];
+    r1[2 * kz + 1] += a * z[4];
+    r2[2 * kz + 1] += a * z[5];
+  }
+}
+
+}  // namespace
+
+// The thermal random stress of docs/thermal.md, drawn in Fourier space: r̂(k) += ξ̂(k) with
+//   ⟨ξ̂_c(k) ξ̂_c(k)*⟩ = n³ σ²(k),  σ²(k) = 2 kT μ λ(k) / (h³ Δt),  λ = −L̂ = (4/h²) Σ_j sin²(πk_j/n),
+// independent components c and modes, i.e. the unnormalised DFT of a real field whose divergence
+// part is the discrete divergence of a random stress (the projection in the solve removes the
+// rest). Each k takes six unit-variance numbers (real and imaginary parts of three components)
+// from one Philox4x32-10 output keyed by the seed, with the counter (mode index, 0, step): the
+// same numbers for any thread count and order. In the k_z = 0 and n/2 planes the half spectrum
+// holds k and −k: k draws with the index of whichever of the two comes first and takes the
+// complex conjugate otherwise (a Hermitian spectrum, i.e. a real field), and a k equal to −k gets
+// a real value of the full variance. k = 0 (λ = 0) gets none: momentum is conserved.
+void FluidSolver::add_noise_slice(int j) {
+  const int n = grid_.n;
+  const int nzh = n / 2 + 1;
+  const double h = grid_.h();
+  // variance of each real and imaginary part: n³ σ²/2 = c λ
+  const double c =
+      params_.thermal_kT * params_.viscosity * double(grid_.size()) / (h * h * h * params_.dt);
+  const double* ls = lap_symbol_.data();
+  const std::uint32_t key0 = std::uint32_t(params_.seed), key1 = std::uint32_t(params_.seed >> 32);
+  const std::uint32_t st0 = std::uint32_t(noise_step_), st1 = std::uint32_t(noise_step_ >> 32);
+  double* r[3] = {reinterpret_cast<double*>(fh_[0]), reinterpret_cast<double*>(fh_[1]),
+                  reinterpret_cast<double*>(fh_[2])};
+  const int nj = (n - j) % n;
+  for (int i = 0; i < n; ++i) {
+    const int ni = (n - i) % n;
+    const double lxy = ls[i] + ls[j];
+    const std::size_t o = 2 * (std::size_t(i) * plane_c_ + std::size_t(j) * nzh);
+    const std::uint32_t row = std::uint32_t((std::size_t(i) * n + j) * nzh);
+    noise_row(1, n / 2, row, lxy, ls, c, st0, st1, key0, key1, r[0] + o, r[1] + o, r[2] + o);
+    for (const int kz : {0, n / 2}) {  // the Hermitian planes
+      const double lam = lxy + ls[kz];
+      if (lam == 0.0) continue;  // k = 0
+      // which of k, −k draws, and whether k is its own conjugate (a real value)
+      std::uint32_t mode = row + std::uint32_t(kz);
+      double sign = 1.0;
+      const bool real_only = ni == i && nj == j;
+      if (!real_only && std::size_t(ni) * n + nj < std::size_t(i) * n + j) {
+        mode = std::uint32_t((std::size_t(ni) * n + nj) * nzh + kz);
+        sign = -1.0;
+      }
+      double z[6];
+      unit_variance6(philox4x32_10({mode, 0u, st0, st1}, key0, key1), z);
+      const std::size_t t = o + 2 * std::size_t(kz);
+      const double a = std::sqrt((real_only ? 2.0 : 1.0) * c * lam);
+      for (int d = 0; d < 3; ++d) {
+        r[d][t] += a * z[d];
+        if (!real_only) r[d][t + 1] += sign * a * z[d + 3];
+      }
+    }
+  }
+}
+
+void FluidSolver::run_noise_only() {
+  if (!(params_.thermal_kT > 0)) return;
+#pragma omp parallel for num_threads(threads_) schedule(static)
+  for (int j = 0; j < grid_.n; ++j) add_noise_slice(j);
+}
+
 void FluidSolver::solve_slice(int j) {
   const int n = grid_.n;
   const double inertia = params_.density / params_.dt;          // ρ/Δt, g Å⁻³ s⁻¹
@@ -307,6 +394,9 @@ void FluidSolver::solve_slice(int j) {
   double* r1 = reinterpret_cast<double*>(fh_[1]);
   double* r2 = reinterpret_cast<double*>(fh_[2]);
   const double gy = gs[j];
+  if (j == 0)  // the uniform body force: the k = 0 entry of the unnormalised DFT is n³ f
+    for (int c = 0; c < 3; ++c)
+      (c == 0 ? r0 : c == 1 ? r1 : r2)[0] += double(grid_.size()) * mean_force_[c];
   for (int i = 0; i < n; ++i) {
     const double gx = gs[i];
     const std::size_t o = 2 * (std::size_t(i) * plane_c_ + std::size_t(j) * nzh);

@@ -9,6 +9,7 @@
 #include <array>
 #include <complex>
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,12 @@ struct FluidParams {
   double viscosity = 1e-10;  ///< μ, g Å⁻¹ s⁻¹
   double dt = 1e-10;         ///< Δt, s
   bool advection = true;     ///< include ρS_h(u); false gives the unsteady Stokes equations
+  /// Thermal fluctuations (docs/thermal.md): kT of the random stress, g Å² s⁻² (0: none, the
+  /// deterministic equations). Its divergence is drawn per Fourier mode k in the solve,
+  ///   ξ̂(k) with ⟨ξ̂ ξ̂ᴴ⟩ = n³ · 2 kT μ λ(k) / (h³ Δt) · I,  λ = −L̂ ≥ 0,
+  /// Hermitian in the k_z = 0, n/2 planes, by Philox4x32-10 keyed by (seed, noise step, mode).
+  double thermal_kT = 0;
+  std::uint64_t seed = 0;  ///< key of the random stress
 };
 
 /// A body force supplied one x-plane at a time (FluidSolver::step(forcing, sampler)), e.g. an
@@ -85,6 +92,19 @@ class FluidSolver {
   }
   void zero_force();
 
+  /// A uniform body-force density (g Å⁻² s⁻²) added to every step's force, in the k = 0 mode of
+  /// the solve (no grid pass): e.g. −F/L³ balancing a net force F spread by a caller, so that
+  /// the fluid's mean momentum stays constant. Zero by default.
+  void set_mean_force(const std::array<double, 3>& f) { mean_force_ = f; }
+  const std::array<double, 3>& mean_force() const { return mean_force_; }
+
+  /// The counter of the thermal noise (FluidParams::thermal_kT > 0): the random stress of a
+  /// step is keyed by (seed, this counter, mode index) and the counter advances by one with
+  /// every step (Navier–Stokes, not solve_stokes). A caller that restores a state sets it (the
+  /// simulation: the step number), so that a resumed run draws the same numbers.
+  void set_noise_step(std::uint64_t s) { noise_step_ = s; }
+  std::uint64_t noise_step() const { return noise_step_; }
+
   /// Advance u by one step Δt with the current force density (MODEL §4). No allocation.
   void step();
   /// The same with the force density of `forcing` added (to force(), if that was written), plane
@@ -133,6 +153,10 @@ class FluidSolver {
   /// per y-slice, inverse 2-D plane FFTs, threaded over planes and slices) with nothing else:
   /// the step's own FFT time. Clobbers force and velocity; not part of the physics.
   void run_split_ffts_only();
+  /// Benchmark aid: the thermal noise of one step alone (add_noise_slice over all y-slices,
+  /// threaded like the step) into the spectrum buffer, which it clobbers; the noise counter is
+  /// left as it was. Nothing without FluidParams::thermal_kT > 0.
+  void run_noise_only();
 
  private:
   GridSpec grid_;
@@ -147,13 +171,15 @@ class FluidSolver {
   double* plane_buf_ = nullptr;  // per thread: 3 real n×n planes of r
   bool force_zero_ = true;       // f_ known to be all zero
   bool plan_measure_ = true;
-  void* plan_plane_r2c_ = nullptr;  // 3 × 2-D (y, z) r2c: plane buffer → r̂ plane
-  void* plan_plane_c2r_ = nullptr;  // 3 × 2-D (y, z) c2r: û plane → u plane
-  void* plan_x_fwd_[2] = {};        // 1-D x FFTs of one y-slice (k_z × 3 components), for the
-  void* plan_x_bwd_[2] = {};        //   two alignments of a slice start (even, odd y)
-  void* plan_forward_ = nullptr;    // benchmark only: threaded 3-D r2c, 3 components
-  void* plan_backward_ = nullptr;   // benchmark only: threaded 3-D c2r, 3 components
-  void* plan_split_r2c_ = nullptr;  // benchmark only: plan_plane_r2c_ reading the force array
+  std::array<double, 3> mean_force_{};  // uniform body force, added to the k = 0 mode
+  std::uint64_t noise_step_ = 0;        // counter of the thermal noise
+  void* plan_plane_r2c_ = nullptr;      // 3 × 2-D (y, z) r2c: plane buffer → r̂ plane
+  void* plan_plane_c2r_ = nullptr;      // 3 × 2-D (y, z) c2r: û plane → u plane
+  void* plan_x_fwd_[2] = {};            // 1-D x FFTs of one y-slice (k_z × 3 components), for the
+  void* plan_x_bwd_[2] = {};            //   two alignments of a slice start (even, odd y)
+  void* plan_forward_ = nullptr;        // benchmark only: threaded 3-D r2c, 3 components
+  void* plan_backward_ = nullptr;       // benchmark only: threaded 3-D c2r, 3 components
+  void* plan_split_r2c_ = nullptr;      // benchmark only: plan_plane_r2c_ reading the force array
   int threads_ = 1;
   std::vector<int> next_, prev_;     // periodic neighbour index i ± 1 (mod n), made once
   std::vector<double> grad_symbol_;  // sin(2πk/n)/h, Å⁻¹, k = 0..n−1; exactly 0 at k = 0, n/2
@@ -164,6 +190,7 @@ class FluidSolver {
   void solve_slice(int j);         // r̂ → ûⁿ⁺¹ in place on the y-slice j: projection,
                                    // implicit viscosity, 1/n³
   void solve_slice_stokes(int j);  // f̂ → û of the Stokes limit in place on the y-slice j
+  void add_noise_slice(int j);     // r̂ += ξ̂ (the thermal random stress) on the y-slice j
 };
 
 }  // namespace ibrod::fluid

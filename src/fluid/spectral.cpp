@@ -18,6 +18,8 @@ void check_fluid_args(const char* who, const GridSpec& grid, const FluidParams& 
   if (!(params.dt > 0.0)) throw std::invalid_argument(w + ": dt must be > 0");
   if (!(params.viscosity >= 0.0)) throw std::invalid_argument(w + ": viscosity must be >= 0");
   if (threads < 0) throw std::invalid_argument(w + ": threads must be >= 0");
+  if (!(params.thermal_kT >= 0.0) || !std::isfinite(params.thermal_kT))
+    throw std::invalid_argument(w + ": thermal_kT must be finite and >= 0");
 }
 
 void make_spectral_symbols(int n, double h, std::vector<double>& grad, std::vector<double>& lap) {

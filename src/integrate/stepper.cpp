@@ -49,6 +49,21 @@ Stepper::Stepper(const StepperParams& p)
   U_.resize(n);
   W_.resize(n);
   if (dist_) rank_sum_.resize(6 * std::size_t(n));
+  const bool external = !p.external_force.isZero(0) || !p.external_torque.isZero(0);
+  if (dist_ && external)
+    throw std::invalid_argument(
+        "Stepper: an external force or torque (external.force_pN, external.torque_pN_nm) runs "
+        "on one process only");
+  // the reaction of the external force: a uniform body force −F/L³ on the fluid
+  if (fluid_) {
+    const double vol = p.grid.L * p.grid.L * p.grid.L;
+    fluid_->set_mean_force(
+        {-p.external_force[0] / vol, -p.external_force[1] / vol, -p.external_force[2] / vol});
+  }
+}
+
+void Stepper::set_noise_step(std::uint64_t s) {
+  if (fluid_) fluid_->set_noise_step(s);
 }
 
 Stepper::~Stepper() = default;
@@ -79,6 +94,29 @@ class PhaseClock {
   std::chrono::steady_clock::time_point last_;
 };
 
+void Stepper::add_external(const std::vector<Vec3>& X) {
+  const std::size_t n = X.size();
+  if (n == 0) return;
+  if (!p_.external_force.isZero(0)) {
+    const Vec3 f = p_.external_force / double(n);
+    for (Vec3& F : F_) F += f;
+  }
+  if (!p_.external_torque.isZero(0)) {
+    // ω = I⁻¹ τ with I = Σ (|r|² 1 − r rᵀ), r = X_k − X̄: the rigid rotation's force pattern
+    // f_k = ω × r_k has Σ f_k = ω × Σ r_k = 0 and Σ r_k × f_k = I ω = τ
+    Vec3 c = Vec3::Zero();
+    for (const Vec3& x : X) c += x;
+    c /= double(n);
+    Mat3 I = Mat3::Zero();
+    for (const Vec3& x : X) {
+      const Vec3 r = x - c;
+      I += r.squaredNorm() * Mat3::Identity() - r * r.transpose();
+    }
+    const Vec3 w = I.completeOrthogonalDecomposition().solve(p_.external_torque);
+    for (std::size_t k = 0; k < n; ++k) F_[k] += w.cross(X[k] - c);
+  }
+}
+
 StepEnergies Stepper::compute_forces(const rod::RodState& s) {
   PhaseClock none(nullptr);
   return forces(s, none);
@@ -93,6 +131,7 @@ StepEnergies Stepper::forces(const rod::RodState& s, PhaseClock& clock) {
   // MODEL §3 sign convention: −∂E/∂X of every non-elastic potential goes to the fluid unchanged.
   if (p_.electro.enabled) e.electro = electro_.accumulate(s.X, F_);
   if (p_.steric.enabled) e.steric = steric_.accumulate(s.X, F_);
+  add_external(s.X);
   clock.mark(1);
   return e;
 }

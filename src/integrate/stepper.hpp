@@ -18,6 +18,7 @@
 // everywhere), so every rank holds bitwise the same rod state after each step. (The distributed
 // step uses the whole-grid Coupler restricted to the rank's slab, not the PlaneCoupler.)
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -42,6 +43,13 @@ struct StepperParams {
   bool plan_measure = true;  ///< FFTW_MEASURE plans (slower start, faster steps)
   /// the fluid split over the ranks of MPI_COMM_WORLD (MPI initialised; see the file comment)
   bool distributed = false;
+  /// external load on the rod (`external.force_pN`, `external.torque_pN_nm`; docs/thermal.md):
+  /// a total force, g Å s⁻², spread evenly over the points (F/n each), its reaction −F/L³ a
+  /// uniform body force on the fluid (the fluid's mean momentum stays constant); and a torque
+  /// about the rod's centroid, g Å² s⁻², as point forces ω × (X_k − X̄) with
+  /// Σ (X_k − X̄) × (ω × (X_k − X̄)) = torque (they add no net force)
+  Vec3 external_force = Vec3::Zero();
+  Vec3 external_torque = Vec3::Zero();
 };
 
 /// Potential energies of the state whose forces compute_forces() evaluated, g Å² s⁻².
@@ -93,6 +101,9 @@ class Stepper {
   StepEnergies compute_forces(const rod::RodState& s);
 
   const StepperParams& params() const { return p_; }
+  /// The counter of the fluid's thermal noise (fluid::FluidSolver::set_noise_step); the
+  /// simulation sets it to its step number before each step.
+  void set_noise_step(std::uint64_t s);
   /// The serial fluid solver (throws std::logic_error when StepperParams::distributed).
   fluid::FluidSolver& fluid() { return *serial_fluid(); }
   const fluid::FluidSolver& fluid() const { return *serial_fluid(); }
@@ -131,6 +142,7 @@ class Stepper {
   std::vector<double> rank_sum_;  // distributed: [6n] U then W, packed for sum_over_ranks
   const fluid::FluidSolver* serial_fluid() const;
   StepEnergies forces(const rod::RodState& s, PhaseClock& clock);
+  void add_external(const std::vector<Vec3>& X);  // the external force and torque into F_
   fluid::FluidSolver* serial_fluid();
 };
 

@@ -1,10 +1,19 @@
 #include "sim/rod_problem.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 namespace ibrod::sim {
 
-std::string rod_problem(const rod::RodState& s, double ds) {
+double spacing_tolerance(const rod::RodParams& rod, double thermal_kT) {
+  if (!(thermal_kT > 0)) return 0.5;
+  const double b = std::min(rod.b[0], std::min(rod.b[1], rod.b[2]));
+  return std::max(0.5, 7.0 * std::sqrt(thermal_kT * rod.ds / b) / rod.ds);
+}
+
+std::string rod_problem(const rod::RodState& s, double ds, double tolerance) {
+  const double lo = std::max(0.05, 1.0 - tolerance), hi = 1.0 + tolerance;
   const int n = s.size();
   char buf[256];
   for (int k = 0; k < n; ++k) {
@@ -18,10 +27,10 @@ std::string rod_problem(const rod::RodState& s, double ds) {
   for (int k = 0; k < n; ++k) {
     const int k1 = k + 1 == n ? 0 : k + 1;
     const double r = (s.X[k1] - s.X[k]).norm() / ds;
-    if (!(r >= 0.5 && r <= 1.5)) {
+    if (!(r >= lo && r <= hi)) {
       std::snprintf(buf, sizeof buf,
-                    "the spacing of points %d and %d is %.4g Δs (allowed: 0.5 to 1.5 Δs)", k, k1,
-                    r);
+                    "the spacing of points %d and %d is %.4g Δs (allowed: %.4g to %.4g Δs)", k, k1,
+                    r, lo, hi);
       return buf;
     }
   }

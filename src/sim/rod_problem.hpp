@@ -7,7 +7,14 @@
 namespace ibrod::sim {
 
 /// Empty if the rod is sane; otherwise what is wrong, naming the point: a non-finite position or
-/// triad, an adjacent spacing off Δs by more than 50 %, a triad off orthonormal by more than 1e-3.
-std::string rod_problem(const rod::RodState& s, double ds);
+/// triad, an adjacent spacing off Δs by more than `tolerance` (relative; 50 % by default; never
+/// below 0.05 Δs), a triad off orthonormal by more than 1e-3.
+std::string rod_problem(const rod::RodState& s, double ds, double tolerance = 0.5);
+
+/// The spacing tolerance of rod_problem for a run: 0.5, or with thermal noise (docs/thermal.md)
+/// seven standard deviations of the thermal stretch or shear of one segment,
+/// 7 √(kT Δs / min(b1, b3)) / Δs, if that is larger (0.94 · 7/6 for the reference parameters:
+/// a 50 % stretch is a 3σ event there, not a blow-up).
+double spacing_tolerance(const rod::RodParams& rod, double thermal_kT);
 
 }  // namespace ibrod::sim

@@ -50,6 +50,16 @@ SimParams checked(SimParams p) {
         "Simulation: output intervals must be positive (frames, "
         "checkpoints: or 0)");
   p.stepper.fluid.dt = p.dt;  // the fluid's Δt is the simulation's
+  if (p.stepper.fluid.thermal_kT > 0) {
+    if (p.scheme == TimeScheme::implicit_step)
+      throw std::invalid_argument(
+          "Simulation: thermal noise (solvent.thermal) needs the explicit scheme "
+          "(time.scheme = \"explicit\")");
+    // docs/thermal.md: with noise the fluid never comes to rest, so the kinetic-energy
+    // equilibrium rule (and the stability test it triggers) is off; a run ends at t_end
+    p.stop_kinetic = 0;
+    p.stability.enabled = false;
+  }
   if (p.scheme == TimeScheme::implicit_step) {
     if (p.stepper.distributed)
       throw std::invalid_argument("Simulation: the implicit scheme runs on one process only");
@@ -89,6 +99,7 @@ void Simulation::step() {
     ++step_;
     return;
   }
+  stepper_.set_noise_step(std::uint64_t(step_));  // the noise of step n: resumes draw alike
   stepper_.step(rod_);
   ++step_;
   time_ += p_.dt;

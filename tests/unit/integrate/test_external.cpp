@@ -1,0 +1,187 @@
+// Unit tests of the external load on the rod (external.force_pN, external.torque_pN_nm;
+// docs/thermal.md): the point forces it adds (total force, zero net force and the torque of the
+// rigid-rotation pattern), and a ring pulled through the fluid: it moves along the force with a
+// velocity linear in the force while the fluid's mean velocity stays zero. 16³, 60 points.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "config/config.hpp"
+#include "core/units.hpp"
+#include "integrate/implicit.hpp"
+#include "integrate/stepper.hpp"
+#include "sim/simulation.hpp"
+
+namespace ibrod::integrate {
+namespace {
+
+sim::SimParams ring_params(const std::vector<double>& force_pN,
+                           const std::vector<double>& torque_pN_nm) {
+  config::Config c;
+  c.grid_n = 16;
+  c.grid_box_A = 200;
+  c.rod_base_pairs = 60;
+  c.rod_excess_link = 0;
+  c.rod_perturbation = {0.0};
+  c.solvent_advection = false;
+  c.run_threads = 1;
+  c.run_fftw_measure = false;
+  c.external_force_pN = force_pN;
+  c.external_torque_pN_nm = torque_pN_nm;
+  sim::SimParams p = config::to_params(c);
+  p.stepper.fluid.dt = p.dt;
+  return p;
+}
+
+Vec3 centroid(const std::vector<Vec3>& X) {
+  Vec3 c = Vec3::Zero();
+  for (const Vec3& x : X) c += x;
+  return c / double(X.size());
+}
+
+TEST(External, ForceAndTorqueAddTheirPointForces) {
+  const std::vector<double> F{1.5, -2.0, 0.5}, tau{3.0, 1.0, -4.0};
+  const sim::SimParams p0 = ring_params({0, 0, 0}, {0, 0, 0});
+  const sim::SimParams p1 = ring_params(F, tau);
+  rod::RodState s = rod::twisted_circle(p0.stepper.rod, p0.circle);
+  // a generic shape: the ring tilted and bent a little
+  for (int k = 0; k < s.size(); ++k)
+    s.X[k] += Vec3(0.3 * std::sin(2.0 * k), 0, 2.0 * std::cos(k * 0.1));
+  Stepper a(p0.stepper), b(p1.stepper);
+  a.compute_forces(s);
+  b.compute_forces(s);
+  const Vec3 c = centroid(s.X);
+  Vec3 sum = Vec3::Zero(), moment = Vec3::Zero();
+  for (int k = 0; k < s.size(); ++k) {
+    const Vec3 d = b.forces()[k] - a.forces()[k];
+    sum += d;
+    moment += (s.X[k] - c).cross(d);
+    EXPECT_EQ(b.torques()[k], a.torques()[k]);  // point torques untouched
+  }
+  const Vec3 Fi = Vec3(F[0], F[1], F[2]) * units::pN;
+  const Vec3 ti = Vec3(tau[0], tau[1], tau[2]) * units::pN * units::nm;
+  EXPECT_LT((sum - Fi).norm(), 1e-12 * Fi.norm());
+  EXPECT_LT((moment - ti).norm(), 1e-10 * ti.norm());
+  // the reaction −F/L³ on the fluid
+  const double vol = std::pow(p1.stepper.grid.L, 3);
+  for (int d = 0; d < 3; ++d) EXPECT_DOUBLE_EQ(b.fluid().mean_force()[d], -Fi[d] / vol);
+}
+
+// Mean velocity of the centroid over `steps` steps, Å/s.
+Vec3 pulled_velocity(double fx_pN, int steps) {
+  const sim::SimParams p = ring_params({fx_pN, 0, 0}, {0, 0, 0});
+  rod::RodState s = rod::twisted_circle(p.stepper.rod, p.circle);
+  Stepper st(p.stepper);
+  const Vec3 c0 = centroid(s.X);
+  for (int i = 0; i < steps; ++i) st.step(s);
+  // the fluid's mean velocity stays zero: the reaction balances the spread force
+  for (int c = 0; c < 3; ++c) {
+    double mean = 0;
+    const std::size_t n3 = p.stepper.grid.size();
+    for (std::size_t t = 0; t < n3; ++t) mean += st.fluid().velocity(c)[t];
+    EXPECT_LT(std::abs(mean / double(n3)), 1.0) << "component " << c;  // Å/s; the ring: ~1e10
+  }
+  return (centroid(s.X) - c0) / (steps * p.dt);
+}
+
+TEST(External, PulledRingMovesAlongTheForceLinearly) {
+  const Vec3 v1 = pulled_velocity(1.0, 30), v2 = pulled_velocity(2.0, 30),
+             vm = pulled_velocity(-1.0, 30);
+  EXPECT_GT(v1[0], 0);
+  // transverse drift: none by symmetry (the ring lies in a plane through the force)
+  EXPECT_LT(std::hypot(v1[1], v1[2]), 1e-3 * v1[0]);
+  // linear: twice the force, twice the velocity; the opposite force, the opposite velocity
+  // (the kernel weights change as the ring moves, a nonlinearity of relative size ~1e-3 here)
+  EXPECT_NEAR(v2[0] / v1[0], 2.0, 2e-2);
+  EXPECT_NEAR(vm[0] / v1[0], -1.0, 1e-2);
+}
+
+}  // namespace
+}  // namespace ibrod::integrate
+
+namespace ibrod::integrate {
+namespace {
+
+// The implicit scheme (Stokes limit) picks the external force up through compute_forces: its
+// pulled ring moves like the explicit scheme's, whose fluid has inertia. Measured: the implicit
+// velocity is 4.7 % higher for this 60-point ring (1.1 % for the 100-point ring of
+// docs/thermal.md); not explained yet (docs/thermal.md), hence 8 %: a force missing from either
+// scheme, or counted twice, would be O(1).
+TEST(External, ImplicitSchemePullsTheRingAtTheExplicitVelocity) {
+  config::Config c;
+  c.grid_n = 16;
+  c.grid_box_A = 200;
+  c.rod_base_pairs = 60;
+  c.rod_excess_link = 0;
+  c.rod_perturbation = {0.0};
+  c.run_threads = 1;
+  c.run_fftw_measure = false;
+  c.external_force_pN = {1.0, 0, 0};
+  c.time_scheme = "implicit";
+  c.time_dt_ns = 1.0;
+  c.time_t_end_us = 0.02;
+  sim::Simulation s(config::to_params(c));
+  const Vec3 c0 = centroid(s.rod().X);
+  s.step();  // the flow develops within the first step of the explicit scheme: skip it in both
+  const Vec3 c1 = centroid(s.rod().X);
+  const double t1 = s.time();
+  while (!s.at_end()) s.step();
+  const double v_implicit = (centroid(s.rod().X) - c1)[0] / (s.time() - t1);
+  (void)c0;
+  // the explicit scheme's steady velocity, after 10 steps of start-up
+  const sim::SimParams p = ring_params({1.0, 0, 0}, {0, 0, 0});
+  rod::RodState r = rod::twisted_circle(p.stepper.rod, p.circle);
+  Stepper st(p.stepper);
+  for (int i = 0; i < 10; ++i) st.step(r);
+  const Vec3 e0 = centroid(r.X);
+  for (int i = 0; i < 100; ++i) st.step(r);
+  const double v_explicit = (centroid(r.X) - e0)[0] / (100 * p.dt);
+  std::printf("pulled ring: v_implicit / v_explicit = %.4f\n", v_implicit / v_explicit);
+  EXPECT_NEAR(v_implicit / v_explicit, 1.0, 0.08);
+}
+
+// The stochastic drift kT ∂_X·M of the overdamped limit, which the thermal scheme does not add
+// (docs/thermal.md): measured on a 60-point ring at 16³ by central differences of the Stokes
+// mobility, column by column: drift_k = Σ_{l,j} ∂M_{k,(l,j)}/∂X_{l,j}. The bound asserted: over one
+// step of 0.1 ns the drift moves a point by less than a tenth of the thermal displacement
+// √(2 kT M_self Δt).
+TEST(ThermalDrift, DivergenceOfTheMobilityIsSmallAgainstTheNoise) {
+  const sim::SimParams p = ring_params({0, 0, 0}, {0, 0, 0});
+  rod::RodState s = rod::twisted_circle(p.stepper.rod, p.circle);
+  Stepper st(p.stepper);
+  ImplicitStepper imp(st, ImplicitParams{});
+  const int n = s.size();
+  const double delta = 0.01;  // Å; the kernel varies on the scale h = 12.5 Å
+  std::vector<Vec3> F(n, Vec3::Zero()), T(n, Vec3::Zero()), Up(n), Um(n), W(n);
+  std::vector<Vec3> drift(n, Vec3::Zero());  // ∂·M, s g⁻¹ Å⁻¹
+  for (int l = 0; l < n; ++l)
+    for (int j = 0; j < 3; ++j) {
+      F[l] = Vec3::Unit(j);
+      std::vector<Vec3> X = s.X;
+      X[l][j] += delta;
+      imp.mobility(X, F, T, Up, W);
+      X[l][j] -= 2 * delta;
+      imp.mobility(X, F, T, Um, W);
+      for (int k = 0; k < n; ++k) drift[k] += (Up[k] - Um[k]) / (2 * delta);
+      F[l].setZero();
+    }
+  double worst = 0;
+  Vec3 mean = Vec3::Zero();
+  for (const Vec3& d : drift) {
+    worst = std::max(worst, d.norm());
+    mean += d / double(n);
+  }
+  const double kT = p.kT, dt = p.dt;
+  const double M = imp.self_mobility_translation();      // s g⁻¹
+  const double drift_step = kT * worst * dt;             // Å
+  const double noise_step = std::sqrt(2 * kT * M * dt);  // Å
+  std::printf(
+      "ThermalDrift: max |kT ∂·M| = %.4g Å/ns (centroid: %.3g Å/ns); per 0.1 ns step %.4g Å "
+      "against the thermal %.4g Å (ratio %.3g)\n",
+      kT * worst * 1e-9, kT * mean.norm() * 1e-9, drift_step, noise_step, drift_step / noise_step);
+  EXPECT_LT(drift_step, 0.1 * noise_step);
+}
+
+}  // namespace
+}  // namespace ibrod::integrate
