@@ -10,4 +10,9 @@ namespace ibrod::sim {
 /// triad, an adjacent spacing off Δs by more than 50 %, a triad off orthonormal by more than 1e-3.
 std::string rod_problem(const rod::RodState& s, double ds);
 
+/// Empty if `s` may be a rod of n points Δs = ds apart (an initial shape, a state set from
+/// Python); otherwise what is wrong: a count of positions or triads other than n, what
+/// rod_problem finds, or a left-handed triad (det D < 0: D³ must be D¹ × D²).
+std::string state_problem(const rod::RodState& s, int n, double ds);
+
 }  // namespace ibrod::sim
