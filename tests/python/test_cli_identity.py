@@ -125,3 +125,20 @@ def test_initial_shape_errors(binary, tmp_path, cfg):
     with pytest.raises(ibrod.ConfigError) as e:
         ibrod.Simulation(c)
     assert "100 positions" in str(e.value) and "rod.base_pairs" in str(e.value)
+
+
+def test_a_python_run_directory_continues_with_the_cli(binary, tmp_path, cfg):
+    # Python runs 120 steps into DIR; `ibrod run --resume DIR` extends it to the 200 steps of
+    # time.t_end_us = 0.02 and ends where one CLI run of 200 steps ends, bit for bit
+    ref = ibrod.read_run(cli_run(binary, cfg, tmp_path, "cli"))
+    out = tmp_path / "py"
+    sim = ibrod.Simulation(cfg, output=str(out))
+    sim.run(steps=120)
+    assert ibrod.read_run(out)["config"]["time"]["t_end_us"] == pytest.approx(0.012)
+    del sim  # closes the directory (one writer at a time)
+    r = run_cli(binary, ["run", "--resume", str(out), "--set", "time.t_end_us=0.02"])
+    assert r.returncode == 0, r.stderr
+    got = ibrod.read_run(out)
+    np.testing.assert_array_equal(got["final_state"]["positions"], ref["final_state"]["positions"])
+    np.testing.assert_array_equal(got["final_state"]["triads"], ref["final_state"]["triads"])
+    np.testing.assert_array_equal(got["timeseries"]["step"], ref["timeseries"]["step"])
