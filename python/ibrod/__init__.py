@@ -42,8 +42,8 @@ def _toml_value(value, key):
         if math.isinf(v):
             return "inf" if v > 0 else "-inf"
         return repr(v)
-    if isinstance(value, str):
-        return json.dumps(value)  # a TOML basic string (JSON's escapes are TOML's)
+    if isinstance(value, (str, os.PathLike)):
+        return json.dumps(os.fspath(value))  # a TOML basic string (JSON's escapes are TOML's)
     if isinstance(value, dict):
         return "{ " + ", ".join(f"{k} = {_toml_value(v, key)}" for k, v in value.items()) + " }"
     if isinstance(value, (list, tuple, np.ndarray)):

@@ -9,6 +9,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <atomic>
 #include <chrono>
 #include <csignal>
 #include <cstring>
@@ -55,7 +56,13 @@ class PySimulation {
     run_->prepare();
   }
 
-  sim::Simulation& s() { return run_->simulation(); }
+  // The state while run() advances it (the GIL released) belongs to the loop: another thread
+  // that asks for it is refused rather than handed a state in the middle of a step.
+  sim::Simulation& s() {
+    if (running_)
+      throw std::runtime_error("Simulation: run() is advancing this simulation in another thread");
+    return run_->simulation();
+  }
 
   py::dict run(std::optional<std::int64_t> steps, std::optional<double> until_us) {
     sim::Simulation& sm = s();
@@ -81,6 +88,11 @@ class PySimulation {
     }
     driver::RunResult r;
     {
+      struct Running {  // running_ for the loop's duration, exceptions included
+        std::atomic<bool>& flag;
+        explicit Running(std::atomic<bool>& f) : flag(f) { flag = true; }
+        ~Running() { flag = false; }
+      } running(running_);
       py::gil_scoped_release release;
       using Clock = std::chrono::steady_clock;
       auto last = Clock::now();
@@ -161,6 +173,7 @@ class PySimulation {
   }
 
   py::dict observables() {
+    s();  // not while run() advances it
     const auto& rows = run_->rows();
     const py::ssize_t R = py::ssize_t(rows.size());
     py::dict d;
@@ -185,6 +198,7 @@ class PySimulation {
  private:
   std::unique_ptr<driver::Run> run_;
   std::vector<double> scratch_;
+  std::atomic<bool> running_{false};
 };
 
 }  // namespace

@@ -160,3 +160,21 @@ def test_output_directory_refused_unless_overwrite(tmp_path, cfg):
         ibrod.Simulation(cfg, output=str(out))
     assert "overwrite" in str(e.value)
     ibrod.Simulation(cfg, output=str(out), overwrite=True).run(steps=5)
+
+
+def test_the_state_is_refused_to_other_threads_while_running(cfg):
+    import time
+
+    sim = ibrod.Simulation(cfg)
+    t = threading.Thread(target=sim.run, kwargs={"steps": 2000})
+    t.start()
+    refused = False
+    while t.is_alive() and not refused:
+        try:
+            sim.positions
+        except RuntimeError as e:
+            refused = "another thread" in str(e)
+        time.sleep(0.005)
+    t.join()
+    assert refused
+    assert sim.step == 2000  # the run itself was not disturbed
