@@ -45,6 +45,7 @@ class PySimulation {
                bool progress) {
     driver::RunOptions o;
     o.output_dir = output.value_or("");
+    o.write_files = output.has_value();
     if (output && output->empty())
       throw ConfigError("Simulation: output = '' names no directory (None: write no files)");
     o.overwrite = overwrite;

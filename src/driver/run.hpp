@@ -29,7 +29,7 @@
 namespace ibrod::driver {
 
 struct RunOptions {
-  std::string output_dir = "ibrod-out";  ///< "": write no files (the Python module's default)
+  std::string output_dir = "ibrod-out";
   bool overwrite = false;      ///< replace the files of an existing, non-empty output directory
   bool resume = false;         ///< continue the run in output_dir from its checkpoint.bin
   bool force = false;          ///< resume even if the configuration differs from the checkpoint's
@@ -42,7 +42,8 @@ struct RunOptions {
   /// the rod and the loop, and rank 0 alone writes files and progress. Every rank must call run().
   int rank = 0;
   int ranks = 1;
-  bool keep_rows = false;  ///< keep every time-series row in memory (Run::rows())
+  bool keep_rows = false;   ///< keep every time-series row in memory (Run::rows())
+  bool write_files = true;  ///< false: no directory, no file (the Python module's default)
 };
 
 struct RunResult {

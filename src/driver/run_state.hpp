@@ -78,8 +78,8 @@ struct Run::State {
 
   void say(const std::string& s) { progress.message(s); }
   void on_root(const std::function<void()>& f) { mpi::on_root(opt.rank, opt.ranks, f); }
-  /// Whether the run writes a directory (RunOptions::output_dir not empty).
-  bool writes() const { return !opt.output_dir.empty(); }
+  /// Whether the run writes its directory (RunOptions::write_files).
+  bool writes() const { return opt.write_files; }
   /// f on rank 0 when the run writes files, else nothing.
   void on_disk(const std::function<void()>& f) {
     if (writes()) on_root(f);
