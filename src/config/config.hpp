@@ -57,6 +57,9 @@ struct Config {
   double rod_shear_modulus_dyn = 5e-5;              ///< b1 = b2, dyn
   double rod_stretch_modulus_dyn = 5e-5;            ///< b3, dyn
   double rod_intrinsic_twist_per_A = 0.0;           ///< Ω³₀, rad/Å
+  std::vector<double> rod_intrinsic_curvature_per_A{0.0, 0.0};  ///< Ω¹₀, Ω²₀, rad/Å
+  std::string
+      rod_initial_shape;  ///< rod.initial_shape: "" (the twisted circle) or a file (io/rod_shape)
   // [solvent]
   double solvent_salt_M = 0.1;  ///< Cs, mol/L
   double solvent_viscosity_poise = 0.01;

@@ -77,6 +77,12 @@ void validate(const Config& c) {
     bad("rod.intrinsic_twist_per_A", fmt(c.rod_intrinsic_twist_per_A),
         "|Ω³₀| <= π / (2 rod.rise_A) = " + fmt(kMaxTwistPerSegment / c.rod_rise_A) +
             " rad/Å (a twist of at most π/2 between neighbouring triads; docs/config.md)");
+  for (int i = 0; i < 2; ++i)
+    if (std::abs(c.rod_intrinsic_curvature_per_A[i]) * c.rod_rise_A > kMaxTwistPerSegment)
+      bad("rod.intrinsic_curvature_per_A", fmt(c.rod_intrinsic_curvature_per_A[i]),
+          "|Ω" + std::string(i == 0 ? "¹" : "²") +
+              "₀| <= π / (2 rod.rise_A) = " + fmt(kMaxTwistPerSegment / c.rod_rise_A) +
+              " rad/Å (a bend of at most π/2 between neighbouring triads)");
   // MODEL §5: sin β must be a sine
   const double a = c.rod_bend_modulus_erg_cm * units::erg_cm;
   const double a3 = c.rod_twist_modulus_erg_cm * units::erg_cm;
@@ -106,7 +112,8 @@ sim::SimParams to_params(const Config& c) {
   s.rod.a = Vec3(a, a, c.rod_twist_modulus_erg_cm * erg_cm);
   const double b = c.rod_shear_modulus_dyn * dyn;
   s.rod.b = Vec3(b, b, c.rod_stretch_modulus_dyn * dyn);
-  s.rod.omega0 = Vec3(0, 0, c.rod_intrinsic_twist_per_A);
+  s.rod.omega0 = Vec3(c.rod_intrinsic_curvature_per_A[0], c.rod_intrinsic_curvature_per_A[1],
+                      c.rod_intrinsic_twist_per_A);
   p.kT = kT(c.solvent_temperature_K);
   // MODEL (2.19–2.22): A = q²/(4π ε0 εw), κ = 0.329 √Cs
   s.electro = interactions::electro_params(c.electrostatics_enabled, c.electrostatics_charge_e,

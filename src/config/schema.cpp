@@ -206,6 +206,41 @@ Key scheme_key() {
   return k;
 }
 
+// rod.intrinsic_curvature_per_A = [Ω¹₀, Ω²₀]: exactly two numbers (checked before any is set)
+Key intrinsic_curvature_key() {
+  const std::string name = "rod.intrinsic_curvature_per_A";
+  Key k = real_array(name, &Config::rod_intrinsic_curvature_per_A, 1e6,
+                     "intrinsic curvatures [Ω¹₀, Ω²₀] about D¹ and D², rad/Å ([0, 0]: straight "
+                     "reference)");
+  const auto set_array = k.set;
+  k.set = [name, set_array, help = k.help](Config& c, const toml::node& n) {
+    const toml::array* a = n.as_array();
+    if (!a || a->size() != 2)
+      bad(name, show(n), "an array of two numbers [Ω¹₀, Ω²₀], rad/Å (" + help + ")");
+    set_array(c, n);
+  };
+  return k;
+}
+
+// rod.initial_shape: a file name (a string key; "" for none)
+Key initial_shape_key() {
+  Key k;
+  k.name = "rod.initial_shape";
+  k.help =
+      "start from this shape instead of the twisted circle: a run's final_state.csv, or "
+      "\"trajectory.h5@FRAME\" (FRAME from 0, -1 the last); \"\": the circle";
+  k.set = [](Config& c, const toml::node& n) {
+    const auto v = n.value_exact<std::string>();
+    if (!v) bad("rod.initial_shape", show(n), "a file name in quotes, or \"\" for the circle");
+    c.rod_initial_shape = *v;
+  };
+  k.put = [](const Config& c, toml::table& t) {
+    t.insert_or_assign("initial_shape", c.rod_initial_shape);
+  };
+  k.value = [](const Config& c) { return "\"" + c.rod_initial_shape + "\""; };
+  return k;
+}
+
 // rod.perturbation_random = { modes = M, amplitude = A, seed = S }: an inline table (a Key whose
 // value is a table). A partial table changes only the sub-keys it names, so that `--set
 // rod.perturbation_random.seed=7` (see set_key) works on top of a file's table. Written back as the
@@ -328,6 +363,8 @@ const std::vector<Key>& schema() {
                "stretch constant b3, dyn"),
       real("rod.intrinsic_twist_per_A", &Config::rod_intrinsic_twist_per_A, -inf, false, inf,
            "intrinsic twist Ω³₀, rad/Å (0: untwisted reference)"),
+      intrinsic_curvature_key(),
+      initial_shape_key(),
       real("solvent.salt_M", &Config::solvent_salt_M, 0, false, 10.0,
            "monovalent salt concentration Cs, mol/L"),
       physical("solvent.viscosity_poise", &Config::solvent_viscosity_poise, 0.01, false,

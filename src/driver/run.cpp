@@ -18,6 +18,7 @@
 #include "io/atomic_file.hpp"
 #include "io/csv.hpp"
 #include "io/npy.hpp"
+#include "io/rod_shape.hpp"
 #include "sim/rod_problem.hpp"
 #include "sim/stability.hpp"
 
@@ -61,7 +62,7 @@ void Run::State::prepare_directory() {
     if (config_changed) on_root([&] { io::write_file_atomic(dir.config(), config_text); });
     return;
   }
-  on_root([&] {
+  on_disk([&] {
     prepare_output_dir(dir, opt.overwrite, lock);
     io::write_file_atomic(dir.config(), config_text);
   });
@@ -86,8 +87,12 @@ void Run::State::build_simulation() {
     // the distributed fluid checks what every rank sees alike: a bad input on every rank
     throw ConfigError(std::string("run: ") + e.what());
   }
+  if (initial_shape && !checkpoint) {
+    sim->set_rod_state(std::move(*initial_shape));  // checked in Run::Run
+    initial_shape.reset();
+  }
   // distributed: rank 0 holds every rank's plans (fftw_mpi_gather_wisdom)
-  on_root([&] {
+  on_disk([&] {
     const std::string wisdom = fluid::wisdom_text();
     if (wisdom.empty()) throw RunError("output: cannot export the FFTW plans");
     io::write_file_atomic(dir.wisdom(), wisdom);
@@ -95,7 +100,7 @@ void Run::State::build_simulation() {
 }
 
 void Run::State::open_files() {
-  on_root([&] {
+  on_disk([&] {
     // extending a run that stopped at its end time: its last row and frame were written because
     // it stopped, not by the schedule; the uninterrupted longer run has them only if on schedule
     std::int64_t rows_to = result.resumed_from, frames_to = result.resumed_from;
@@ -156,7 +161,7 @@ std::string Run::State::progress_line(const sim::Observables& o) const {
 }
 
 void Run::State::write_frame() {
-  if (sim->params().output.frames <= 0) return;
+  if (sim->params().output.frames <= 0 || !writes()) return;
   std::array<const double*, 3> u{};
   if (c.output_fluid_vti) u = sim->stepper().whole_velocity(gathered);
   on_root([&] { files->frame(*sim, u); });
@@ -173,11 +178,12 @@ void Run::State::write_checkpoint(StopReason reason) {
   }
   meta.stop_reason = to_string(reason);
   meta.wall_s = wall_before + seconds_since(t0);
+  result.checkpoint_step = meta.step;
+  if (!writes()) return;
   const auto u = sim->stepper().whole_velocity(gathered);
   on_root([&] {
     io::write_checkpoint(dir.checkpoint(), meta, sim->rod(), sim->params().stepper.grid.n, u);
   });
-  result.checkpoint_step = meta.step;
 }
 
 void Run::State::finish(const sim::Observables& o, const std::string& stop_reason,
@@ -191,11 +197,11 @@ void Run::State::finish(const sim::Observables& o, const std::string& stop_reaso
   r.link_drift = o.link - r.initial.link;
   r.max_link_drift = meta.max_link_drift;
   r.self_passage_warning = meta.self_passage_warning;
-  const bool npy =
-      error.empty() && stop_reason != to_string(StopReason::interrupted) && c.output_fluid_velocity;
+  const bool npy = writes() && error.empty() && stop_reason != to_string(StopReason::interrupted) &&
+                   c.output_fluid_velocity;
   std::array<const double*, 3> u{};
   if (npy) u = sim->stepper().whole_velocity(gathered);
-  on_root([&] {
+  on_disk([&] {
     if (error.empty()) io::write_file_atomic(dir.final_state(), io::final_state_csv(sim->rod()));
     if (npy) io::write_velocity_npy(dir.velocity(), c.grid_n, u[0], u[1], u[2]);
     io::write_file_atomic(dir.summary(),
@@ -213,7 +219,7 @@ void Run::State::blow_up(const std::string& what) {
                     "(time.dt_ns = " +
                     format_g(c.time_dt_ns) +
                     "): try a smaller time.dt_ns, or check the moduli and forces.";
-  if (result.checkpoint_step >= 0)
+  if (result.checkpoint_step >= 0 && writes())
     msg += " The last good checkpoint (step " + std::to_string(result.checkpoint_step) +
            ") is kept in " + dir.checkpoint().string() + ".";
   try {
@@ -259,7 +265,7 @@ StopReason Run::State::test_stability(StopReason candidate) {
   if (o.stable) return candidate;
   if (const std::string bad = sim::rod_problem(s.rod(), c.rod_rise_A); !bad.empty()) blow_up(bad);
   last_row = observe_checked();
-  on_root([&] { files->row(last_row); });
+  record_row();
   check_link(last_row);
   return s.at_end() ? StopReason::end_time : StopReason::none;
 }
@@ -283,27 +289,29 @@ void Run::State::check_link(const sim::Observables& o) {
 }
 
 // The time loop: step, check, and write what the Simulation's schedule asks for.
-RunResult Run::State::loop(const SignalGuard& signals) {
+RunResult Run::State::loop(const std::function<int()>& pending, std::int64_t max_steps) {
   sim::Simulation& s = *sim;
   loop_start = Clock::now();
   start_step = s.step_count();
+  result.signal = 0;
   const double ds = c.rod_rise_A;
   // docs/thermal.md: with noise a segment's thermal stretch alone may pass 50 %
   const double tol =
       sim::spacing_tolerance(s.params().stepper.rod, s.params().stepper.fluid.thermal_kT);
   try {
     ensure_space();
-    if (result.resumed_from < 0) {
+    if (!begun && result.resumed_from < 0) {
       if (const std::string bad = sim::rod_problem(s.rod(), ds, tol); !bad.empty())
         blow_up("the initial state is not sane: " + bad);
       last_row = observe_checked();
       result.initial = meta.initial = last_row;
-      on_root([&] { files->row(last_row); });
+      record_row();
       write_frame();
       write_checkpoint(StopReason::none);
-    } else {
+    } else if (!begun) {
       last_row = s.observe();
     }
+    begun = true;
 
     // a line at once, with the state's real values (a large grid's first output step may be
     // minutes away)
@@ -317,9 +325,10 @@ RunResult Run::State::loop(const SignalGuard& signals) {
       write_checkpoint(reason);
       progress.update(progress_line(last_row), seconds_since(loop_start), /*last=*/true);
     }
+    std::int64_t done = 0;  // steps of this segment
     while (reason == StopReason::none) {
       // distributed: the ranks agree on a signal (each may see it after another step)
-      if (const int sig = distributed ? int(mpi::max(signals.pending())) : signals.pending()) {
+      if (const int sig = distributed ? int(mpi::max(pending())) : pending()) {
         // the end of the current step: save it, then stop
         if (result.checkpoint_step != s.step_count()) write_checkpoint(StopReason::none);
         progress.finish_line();
@@ -333,14 +342,17 @@ RunResult Run::State::loop(const SignalGuard& signals) {
         return result;
       }
       s.step();
+      ++done;
       if (const std::string bad = sim::rod_problem(s.rod(), ds, tol); !bad.empty()) blow_up(bad);
-      const bool output_step = s.output_due();
+      const bool segment_end = max_steps > 0 && done >= max_steps;
+      const bool output_step = s.output_due() || segment_end;
       if (output_step) {
         last_row = observe_checked();
-        on_root([&] { files->row(last_row); });
+        record_row();
         check_link(last_row);
         reason = s.stop_reason(last_row);
         if (reason == StopReason::equilibrium) reason = test_stability(reason);
+        if (reason == StopReason::none && segment_end) reason = StopReason::end_time;
       }
       const bool stop = reason != StopReason::none;
       const bool frame_step = s.frame_due(stop);
@@ -379,6 +391,7 @@ RunResult Run::State::loop(const SignalGuard& signals) {
     }
     progress.finish_line();
     // the advice that works: --resume needs a checkpoint
+    if (!writes()) throw;
     if (what.find("--resume") != std::string::npos || what.find("--overwrite") != std::string::npos)
       throw;
     throw RunError(what + (result.checkpoint_step >= 0
@@ -403,6 +416,18 @@ RunResult Run::State::loop(const SignalGuard& signals) {
 Run::Run(const config::Config& c, const RunOptions& opt) {
   config::validate(c);
   s_ = std::make_unique<State>(c, opt);
+  // rod.initial_shape: read and checked before anything is written (a resumed run has its state)
+  if (!c.rod_initial_shape.empty() && !opt.resume) {
+    const std::string key = "rod.initial_shape";
+    rod::RodState shape = io::read_rod_shape(c.rod_initial_shape, key);
+    const std::string what = key + " = '" + c.rod_initial_shape + "'";
+    if (const std::string bad = sim::state_problem(shape, c.rod_base_pairs, c.rod_rise_A);
+        !bad.empty())
+      throw ConfigError(what + ": " + bad +
+                        " (rod.base_pairs = " + std::to_string(c.rod_base_pairs) +
+                        ", rod.rise_A = " + format_g(c.rod_rise_A) + " Å)");
+    s_->initial_shape = std::move(shape);
+  }
 }
 
 Run::~Run() = default;
@@ -425,8 +450,49 @@ RunResult Run::execute() {
   st.open_files();
   if (st.complete_only) return st.complete();
   st.announce();
-  return st.loop(signals);
+  return st.loop([&] { return signals.pending(); }, -1);
 }
+
+void Run::prepare() {
+  State& st = *s_;
+  if (st.opt.resume || st.distributed)
+    throw ConfigError("run: the step-by-step interface runs a fresh run on one process only");
+  st.check_launch();
+  st.prepare_directory();
+  st.build_simulation();
+  st.restore_state();
+  st.open_files();
+  st.announce();
+}
+
+RunResult Run::advance(std::int64_t max_steps, const std::function<int()>& pending) {
+  State& st = *s_;
+  if (!st.sim) throw std::logic_error("Run::advance: call prepare() first");
+  if (max_steps == 0 || max_steps < -1)
+    throw std::invalid_argument("Run::advance: max_steps must be positive (or -1: no limit)");
+  return st.loop(pending, max_steps);
+}
+
+void Run::set_end_time(double t_end_us) {
+  State& st = *s_;
+  config::Config next = st.user;
+  next.time_t_end_us = t_end_us;
+  config::validate(next);
+  st.user.time_t_end_us = st.c.time_t_end_us = t_end_us;
+  st.config_text = config::to_toml(st.user);
+  st.meta.config_toml = st.config_text;
+  if (st.sim) st.sim->set_t_end(t_end_us * 1e-6);
+  st.on_disk([&] { io::write_file_atomic(st.dir.config(), st.config_text); });
+}
+
+sim::Simulation& Run::simulation() {
+  if (!s_->sim) throw std::logic_error("Run::simulation: call prepare() first");
+  return *s_->sim;
+}
+
+const config::Config& Run::config() const { return s_->c; }
+
+const std::vector<sim::Observables>& Run::rows() const { return s_->rows; }
 
 RunResult run(const config::Config& c, const RunOptions& opt) { return Run(c, opt).execute(); }
 

@@ -17,8 +17,10 @@
 // and recomputes them; the result is bitwise identical to a run that was never interrupted
 // (same plans through fftw.wisdom, the same thread count, deterministic reductions).
 #include <cstdio>
+#include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "config/config.hpp"
 #include "io/observables.hpp"
@@ -40,6 +42,8 @@ struct RunOptions {
   /// the rod and the loop, and rank 0 alone writes files and progress. Every rank must call run().
   int rank = 0;
   int ranks = 1;
+  bool keep_rows = false;   ///< keep every time-series row in memory (Run::rows())
+  bool write_files = true;  ///< false: no directory, no file (the Python module's default)
 };
 
 struct RunResult {
@@ -80,6 +84,25 @@ class Run {
   Run(const Run&) = delete;
   Run& operator=(const Run&) = delete;
   RunResult execute();
+
+  // Step by step (the Python module, python/ibrod): prepare() does what execute() does before
+  // its time loop (the output directory, the Simulation, the files; no signal handlers); then
+  // each advance() runs the same loop as execute() — the same rows, frames, checkpoints, blow-up
+  // checks and final files — for one segment. Not with --resume or MPI.
+  void prepare();
+  /// Runs the time loop until the end time (set_end_time), a stop rule, `max_steps` steps
+  /// (> 0; −1: no limit; the last step then ends the segment as its end time would) or until
+  /// `pending` returns a signal number (asked before every step; the segment then stops as
+  /// `ibrod run` does on SIGINT: checkpoint, final files, RunResult::signal set). Every segment
+  /// ends with the final files (final_state.csv, summary.json) of the run so far.
+  RunResult advance(std::int64_t max_steps, const std::function<int()>& pending);
+  /// Moves the end of the run to t_end_us (time.t_end_us of the configuration and of
+  /// config.toml; validated as the key is). ConfigError if out of range.
+  void set_end_time(double t_end_us);
+  sim::Simulation& simulation();
+  const config::Config& config() const;
+  /// The time-series rows so far (RunOptions::keep_rows).
+  const std::vector<sim::Observables>& rows() const;
 
  private:
   struct State;

@@ -62,7 +62,10 @@ struct Run::State {
   Clock::time_point loop_start;
   std::int64_t start_step = 0;
   std::uintmax_t reserve_bytes = 0;
-  sim::Observables last_row;  // the row of the latest output step
+  sim::Observables last_row;                   // the row of the latest output step
+  std::optional<rod::RodState> initial_shape;  // rod.initial_shape, read and checked up front
+  bool begun = false;                  // the first segment's step 0 (or the resumed row) is done
+  std::vector<sim::Observables> rows;  // opt.keep_rows
 
   State(const config::Config& cfg, const RunOptions& o)
       : user(cfg),
@@ -75,6 +78,16 @@ struct Run::State {
 
   void say(const std::string& s) { progress.message(s); }
   void on_root(const std::function<void()>& f) { mpi::on_root(opt.rank, opt.ranks, f); }
+  /// Whether the run writes its directory (RunOptions::write_files).
+  bool writes() const { return opt.write_files; }
+  /// f on rank 0 when the run writes files, else nothing.
+  void on_disk(const std::function<void()>& f) {
+    if (writes()) on_root(f);
+  }
+  void record_row() {
+    on_disk([&] { files->row(last_row); });
+    if (opt.keep_rows) rows.push_back(last_row);
+  }
 
   void check_launch() const;
   void open_checkpoint();
@@ -91,7 +104,7 @@ struct Run::State {
   std::string progress_line(const sim::Observables& o) const;
   void write_frame();
   void ensure_space() {
-    on_root([&] { files->ensure_space(reserve_bytes, result.checkpoint_step >= 0); });
+    on_disk([&] { files->ensure_space(reserve_bytes, result.checkpoint_step >= 0); });
   }
   void write_checkpoint(StopReason reason);
   void finish(const sim::Observables& o, const std::string& stop_reason, const std::string& error);
@@ -101,7 +114,7 @@ struct Run::State {
   StopReason test_stability(StopReason candidate);
   bool final_files_complete(const std::string& stop_reason) const;
   RunResult complete();
-  RunResult loop(const SignalGuard& signals);
+  RunResult loop(const std::function<int()>& pending, std::int64_t max_steps);
 };
 
 }  // namespace ibrod::driver

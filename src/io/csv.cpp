@@ -81,7 +81,7 @@ std::string final_state_csv(const rod::RodState& s) {
     const Vec3& x = s.X[k];
     const Mat3& D = s.D[k];
     std::snprintf(buf, sizeof buf,
-                  "%.12g,%.12g,%.12g,%.15g,%.15g,%.15g,%.15g,%.15g,%.15g,%.15g,%.15g,%.15g\n", x[0],
+                  "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", x[0],
                   x[1], x[2], D(0, 0), D(1, 0), D(2, 0), D(0, 1), D(1, 1), D(2, 1), D(0, 2),
                   D(1, 2), D(2, 2));
     out += buf;

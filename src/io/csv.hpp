@@ -33,7 +33,8 @@ CsvTable read_csv_table(const std::filesystem::path& path);
 bool parse_double(const std::string& s, double& v);
 
 /// final_state.csv: the header x_A,y_A,z_A,d1x,d1y,d1z,d2x,d2y,d2z,d3x,d3y,d3z and one row per
-/// rod point (positions to 12 significant digits, triad columns D¹, D², D³ to 15).
+/// rod point (positions and triad columns D¹, D², D³ to 17 significant digits: read back, the
+/// numbers are the state's bit for bit; rod.initial_shape starts a run from them).
 std::string final_state_csv(const rod::RodState& s);
 
 /// timeseries.csv cut back to the rows with step <= last_step, in increasing step order, after

@@ -46,4 +46,20 @@ std::string rod_problem(const rod::RodState& s, double ds, double tolerance) {
   return {};
 }
 
+std::string state_problem(const rod::RodState& s, int n, double ds) {
+  if (s.size() != n || int(s.D.size()) != n)
+    return std::to_string(s.size()) + " positions and " + std::to_string(s.D.size()) +
+           " triads; the rod has " + std::to_string(n) + " points (rod.base_pairs)";
+  if (std::string bad = rod_problem(s, ds); !bad.empty()) return bad;
+  for (int k = 0; k < n; ++k)
+    if (const double det = s.D[k].determinant(); !(det > 0)) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf,
+                    "the triad of point %d is left-handed (det D = %.3g); D³ must be D¹ × D²", k,
+                    det);
+      return buf;
+    }
+  return {};
+}
+
 }  // namespace ibrod::sim

@@ -17,4 +17,9 @@ std::string rod_problem(const rod::RodState& s, double ds, double tolerance = 0.
 /// a 50 % stretch is a 3σ event there, not a blow-up).
 double spacing_tolerance(const rod::RodParams& rod, double thermal_kT);
 
+/// Empty if `s` may be a rod of n points Δs = ds apart (an initial shape, a state set from
+/// Python); otherwise what is wrong: a count of positions or triads other than n, what
+/// rod_problem finds, or a left-handed triad (det D < 0: D³ must be D¹ × D²).
+std::string state_problem(const rod::RodState& s, int n, double ds);
+
 }  // namespace ibrod::sim

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "diagnostics/topology.hpp"
+#include "sim/rod_problem.hpp"
 
 namespace ibrod::sim {
 
@@ -88,6 +89,19 @@ Simulation::Simulation(const SimParams& p)
   if (p_.stepper.electro.enabled) electro_circle_ = stepper_.electrostatics().energy(rod_.X);
   if (p_.scheme == TimeScheme::implicit_step)
     implicit_ = std::make_unique<integrate::ImplicitIntegrator>(stepper_, p_.implicit, p_.adaptive);
+}
+
+void Simulation::set_t_end(double t_end) {
+  if (!(t_end > 0) || !std::isfinite(t_end))
+    throw std::invalid_argument("Simulation: t_end must be positive and finite");
+  p_.t_end = t_end;
+}
+
+void Simulation::set_rod_state(rod::RodState s, const std::string& what) {
+  if (const std::string bad = state_problem(s, p_.stepper.rod.n, p_.stepper.rod.ds); !bad.empty())
+    throw std::invalid_argument(what + ": " + bad);
+  rod_ = std::move(s);
+  if (implicit_) implicit_->refresh();
 }
 
 void Simulation::step() {

@@ -109,6 +109,16 @@ class Simulation {
     step_ = step;
     time_ = time;
   }
+  /// Moves the end of the time (t_end, s; > 0): a run continued in segments (the Python module's
+  /// `run(steps=…)`, driver::Run::set_end_time). Throws std::invalid_argument if not positive.
+  void set_t_end(double t_end);
+  /// Replaces the rod's state (an initial shape from a file, the Python module's set_state):
+  /// throws std::invalid_argument naming what is wrong (sim::state_problem: a count of points
+  /// other than rod.base_pairs, a non-finite value, a spacing off Δs by more than 50 %, a triad
+  /// off orthonormal by more than 1e-3 or left-handed); `what` heads the message. The
+  /// implicit scheme refreshes its stiffness at the next step. dE_electro stays relative to the
+  /// initial circle.
+  void set_rod_state(rod::RodState s, const std::string& what = "set_state");
 
   /// One time step: the state and the time advance by Δt (implicit: by the accepted step,
   /// never past t_end).

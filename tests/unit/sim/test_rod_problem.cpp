@@ -30,3 +30,26 @@ TEST(RodProblem, NamesThePointAndTheQuantity) {
   skew.D[6](0, 1) += 0.01;
   EXPECT_THAT(sim::rod_problem(skew, ds), HasSubstr("triad of point 6 is off orthonormal"));
 }
+
+// sim::state_problem: what an initial shape or a state set from Python must be, besides sane.
+TEST(RodProblem, AStateMustHaveTheRodsPointsAndRightHandedTriads) {
+  const double ds = 3.4, r = ds / (2 * std::sin(M_PI / 10));
+  rod::RodState s;
+  for (int k = 0; k < 10; ++k) {
+    s.X.push_back(Vec3(r * std::cos(2 * M_PI * k / 10), r * std::sin(2 * M_PI * k / 10), 0));
+    s.D.push_back(rotation(Vec3(0, 0, 0.1 * k)));
+  }
+  EXPECT_EQ(sim::state_problem(s, 10, ds), "");
+  EXPECT_THAT(sim::state_problem(s, 12, ds), HasSubstr("10 positions and 10 triads"));
+  EXPECT_THAT(sim::state_problem(s, 12, ds), HasSubstr("12 points (rod.base_pairs)"));
+  rod::RodState fewer = s;
+  fewer.D.pop_back();
+  EXPECT_THAT(sim::state_problem(fewer, 10, ds), HasSubstr("9 triads"));
+  rod::RodState mirrored = s;
+  mirrored.D[2].col(2) *= -1;  // orthonormal, but D³ = −D¹ × D²
+  EXPECT_EQ(sim::rod_problem(mirrored, ds), "");
+  EXPECT_THAT(sim::state_problem(mirrored, 10, ds), HasSubstr("point 2 is left-handed"));
+  rod::RodState gap = s;
+  gap.X[5] *= 2.0;  // 2.1 Δs from point 4: a spacing the run would call a blow-up
+  EXPECT_THAT(sim::state_problem(gap, 10, ds), HasSubstr("spacing of points 4 and 5"));
+}

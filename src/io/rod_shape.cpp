@@ -1,0 +1,101 @@
+#include "io/rod_shape.hpp"
+
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+
+#include "core/error.hpp"
+#include "io/csv.hpp"
+#include "io/h5md.hpp"
+
+namespace ibrod::io {
+
+namespace {
+
+// "PATH@FRAME" with FRAME an integer: true and both parts; anything else is a plain path.
+bool split_frame(const std::string& spec, std::string& path, long long& frame) {
+  const auto at = spec.rfind('@');
+  if (at == std::string::npos || at == 0 || at + 1 == spec.size()) return false;
+  const std::string f = spec.substr(at + 1);
+  char* end = nullptr;
+  const long long v = std::strtoll(f.c_str(), &end, 10);
+  if (end != f.c_str() + f.size()) return false;
+  path = spec.substr(0, at);
+  frame = v;
+  return true;
+}
+
+rod::RodState from_csv(const std::string& path, const std::string& key) {
+  const CsvTable t = read_csv_table(path);
+  static const char* names[12] = {"x_A", "y_A", "z_A", "d1x", "d1y", "d1z",
+                                  "d2x", "d2y", "d2z", "d3x", "d3y", "d3z"};
+  for (const char* n : names)
+    if (!t.has(n))
+      throw ConfigError(key + " = '" + path + "': the file has no column " + n +
+                        " (expected the columns of final_state.csv: x_A,y_A,z_A,d1x,d1y,d1z,"
+                        "d2x,d2y,d2z,d3x,d3y,d3z)");
+  const std::size_t n = t.rows();
+  rod::RodState s;
+  s.X.resize(n);
+  s.D.resize(n);
+  for (int c = 0; c < 3; ++c) {
+    const auto x = t.column(names[c]);
+    for (std::size_t k = 0; k < n; ++k) s.X[k][c] = x[k];
+    for (int col = 0; col < 3; ++col) {
+      const auto d = t.column(names[3 + 3 * col + c]);
+      for (std::size_t k = 0; k < n; ++k) s.D[k](c, col) = d[k];
+    }
+  }
+  return s;
+}
+
+rod::RodState from_h5md(const std::string& path, long long frame, const std::string& key) {
+  const std::string what = key + " = '" + path + "@" + std::to_string(frame) + "'";
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) throw ConfigError(what + ": no such file");
+  H5mdSeries e[4];
+  try {
+    const char* names[4] = {"position", "d1", "d2", "d3"};
+    for (int i = 0; i < 4; ++i) e[i] = read_h5md_series(path, names[i]);
+  } catch (const RunError& err) {
+    throw ConfigError(what + ": " + err.what());
+  }
+  const long long T = static_cast<long long>(e[0].step.size());
+  const long long f = frame < 0 ? T + frame : frame;
+  if (f < 0 || f >= T)
+    throw ConfigError(what + ": the file has " + std::to_string(T) + " frames (FRAME from 0 to " +
+                      std::to_string(T - 1) + ", or -1 for the last)");
+  const int n = e[0].n;
+  rod::RodState s;
+  s.X.resize(n);
+  s.D.resize(n);
+  const std::size_t off = std::size_t(f) * std::size_t(n) * 3;
+  for (int k = 0; k < n; ++k)
+    for (int c = 0; c < 3; ++c) {
+      s.X[k][c] = e[0].value[off + 3 * k + c];
+      for (int col = 0; col < 3; ++col) s.D[k](c, col) = e[1 + col].value[off + 3 * k + c];
+    }
+  return s;
+}
+
+}  // namespace
+
+rod::RodState read_rod_shape(const std::string& spec, const std::string& key) {
+  std::string path;
+  long long frame = -1;
+  if (split_frame(spec, path, frame)) return from_h5md(path, frame, key);
+  if (spec.size() > 3 && spec.compare(spec.size() - 3, 3, ".h5") == 0)
+    return from_h5md(spec, -1, key);
+  std::error_code ec;
+  if (!std::filesystem::exists(spec, ec))
+    throw ConfigError(key + " = '" + spec + "': no such file");
+  try {
+    return from_csv(spec, key);
+  } catch (const ConfigError& err) {
+    const std::string m = err.what();
+    if (m.rfind(key, 0) == 0) throw;
+    throw ConfigError(key + " = '" + spec + "': " + m);
+  }
+}
+
+}  // namespace ibrod::io
