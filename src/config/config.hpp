@@ -85,6 +85,11 @@ struct Config {
                                                ///< −1: same as output.every_steps (frame_every())
   std::int64_t output_checkpoint_every_steps = 10000;  ///< steps between checkpoints; 0: only at
                                                        ///< start, end and on SIGINT/SIGTERM
+  /// issue 14: the schedule in simulated time (µs; 0: by steps). A *_us key > 0 takes precedence
+  /// over its *_steps sibling; output.frame_every_steps = −1 follows the rows either way.
+  double output_every_us = 0;
+  double output_frame_every_us = 0;
+  double output_checkpoint_every_us = 0;
   bool output_fluid_vti = false;                       ///< fluid velocity .vti with every frame
   bool output_fluid_velocity = false;                  ///< DIR/velocity.npy at the end (io/npy.hpp)
   // [run]

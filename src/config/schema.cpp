@@ -181,10 +181,15 @@ Key frame_key() {
                   std::numeric_limits<int64_t>::max(),
                   "steps between trajectory frames (H5MD and ParaView; 0: none, -1: same as "
                   "output.every_steps)");
-  k.put = [](const Config& c, toml::table& t) {
-    t.insert_or_assign("frame_every_steps", int64_t(frame_every(c)));
+  // rows in simulated time (output.every_us): −1 stays −1 (frames with every row)
+  const auto resolved = [](const Config& c) {
+    return c.output_every_us > 0 && c.output_frame_every_steps < 0 ? std::int64_t(-1)
+                                                                   : frame_every(c);
   };
-  k.value = [](const Config& c) { return std::to_string(frame_every(c)); };
+  k.put = [=](const Config& c, toml::table& t) {
+    t.insert_or_assign("frame_every_steps", int64_t(resolved(c)));
+  };
+  k.value = [=](const Config& c) { return std::to_string(resolved(c)); };
   return k;
 }
 
@@ -402,6 +407,15 @@ const std::vector<Key>& schema() {
       integer("output.checkpoint_every_steps", &Config::output_checkpoint_every_steps, 0,
               std::numeric_limits<int64_t>::max(),
               "steps between checkpoints (0: only at the start, the end and on SIGINT/SIGTERM)"),
+      real("output.every_us", &Config::output_every_us, 0, false, 1e9,
+           "simulated time between diagnostics rows, µs (0: every output.every_steps steps; "
+           "> 0: takes precedence over it)"),
+      real("output.frame_every_us", &Config::output_frame_every_us, 0, false, 1e9,
+           "simulated time between trajectory frames, µs (0: by output.frame_every_steps; > 0: "
+           "takes precedence over it)"),
+      real("output.checkpoint_every_us", &Config::output_checkpoint_every_us, 0, false, 1e9,
+           "simulated time between checkpoints, µs (0: by output.checkpoint_every_steps; > 0: "
+           "takes precedence over it)"),
       boolean("output.fluid_vti", &Config::output_fluid_vti,
               "also write the fluid velocity (Å/ns) as a ParaView .vti image with every frame"),
       boolean("output.fluid_velocity", &Config::output_fluid_velocity,

@@ -105,9 +105,9 @@ void Run::State::open_files() {
     // it stopped, not by the schedule; the uninterrupted longer run has them only if on schedule
     std::int64_t rows_to = result.resumed_from, frames_to = result.resumed_from;
     if (extension && result.resumed_from > 0) {
+      if (!sim->row_on_schedule()) --rows_to;
       const sim::OutputSchedule& out = sim->params().output;
-      if (rows_to % out.rows != 0) --rows_to;
-      if (out.frames > 0 && frames_to % out.frames != 0) --frames_to;
+      if ((out.frames > 0 || out.frames_every > 0) && !sim->frame_on_schedule()) --frames_to;
     }
     files = std::make_unique<RunFiles>(dir, c, *sim, rows_to, config_text, progress, frames_to);
   });

@@ -46,7 +46,9 @@ namespace {
 SimParams checked(SimParams p) {
   if (!(p.dt > 0) || !(p.t_end > 0))
     throw std::invalid_argument("Simulation: dt and t_end must be positive");
-  if (p.output.rows <= 0 || p.output.frames < 0 || p.output.checkpoints < 0)
+  if (p.output.rows <= 0 || p.output.frames < 0 || p.output.checkpoints < 0 ||
+      !(p.output.rows_every >= 0) || !(p.output.frames_every >= 0) ||
+      !(p.output.checkpoints_every >= 0))
     throw std::invalid_argument(
         "Simulation: output intervals must be positive (frames, "
         "checkpoints: or 0)");
@@ -104,11 +106,41 @@ void Simulation::set_rod_state(rod::RodState s, const std::string& what) {
   if (implicit_) implicit_->refresh();
 }
 
+namespace {
+// the index of the last multiple of `every` at or before t (a multiple reached to round-off
+// counts: time accumulates step by step)
+double multiples(double t, double every) { return std::floor(t / every + 1e-9); }
+}  // namespace
+
+bool Simulation::due(std::int64_t steps, double every) const {
+  if (every > 0) return step_ > 0 && multiples(time_, every) > multiples(prev_time_, every);
+  return steps > 0 && step_ % steps == 0;
+}
+
+bool Simulation::on_schedule(std::int64_t steps, double every) const {
+  if (every > 0) {
+    if (step_ == 0) return true;
+    if (implicit_) return std::abs(time_ / every - std::round(time_ / every)) <= 1e-9;
+    return multiples(time_, every) > multiples(time_ - p_.dt, every);
+  }
+  return steps > 0 && step_ % steps == 0;
+}
+
+double Simulation::time_to_next_output() const {
+  double left = HUGE_VAL;
+  for (double every : {p_.output.rows_every, p_.output.frames_every, p_.output.checkpoints_every})
+    if (every > 0) left = std::min(left, (multiples(time_, every) + 1) * every - time_);
+  return left;
+}
+
 void Simulation::step() {
+  prev_time_ = time_;
   if (implicit_) {
-    // the last step lands on t_end (a stability probe may step beyond it: no cap there)
+    // the last step lands on t_end, and on each multiple of an output interval in simulated
+    // time (a stability probe may step beyond t_end: no cap there)
     const double left = p_.t_end - time_;
-    const double cap = left > 0 ? std::max(left, p_.adaptive.dt_min) : HUGE_VAL;
+    double cap = left > 0 ? left : HUGE_VAL;
+    cap = std::max(std::min(cap, time_to_next_output()), p_.adaptive.dt_min);
     time_ += implicit_->advance(rod_, cap);
     ++step_;
     return;

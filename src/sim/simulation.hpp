@@ -19,11 +19,17 @@ namespace ibrod::sim {
 
 /// When a run writes: a time-series row every `rows` steps and at the end; a trajectory frame
 /// every `frames` steps and at the end (0: none); a checkpoint every `checkpoints` steps (0: only
-/// at the start, at the end and on a signal).
+/// at the start, at the end and on a signal). Each may instead be in simulated time (issue 14:
+/// `*_every` > 0, s, takes precedence over the step count): due at the first step that reaches
+/// or passes each multiple of the interval. The implicit scheme shortens the step that would
+/// pass one, so that its rows, frames and checkpoints fall on the multiples exactly.
 struct OutputSchedule {
   std::int64_t rows = 1000;
   std::int64_t frames = 1000;
   std::int64_t checkpoints = 10000;
+  double rows_every = 0;         ///< s; 0: by steps
+  double frames_every = 0;       ///< s; 0: by steps
+  double checkpoints_every = 0;  ///< s; 0: by steps
 };
 
 /// The time scheme (`time.scheme`): MODEL §4's explicit step (the reference), or the implicit
@@ -108,6 +114,7 @@ class Simulation {
   void restore_clock(std::int64_t step, double time) {
     step_ = step;
     time_ = time;
+    prev_time_ = time;
   }
   /// Moves the end of the time (t_end, s; > 0): a run continued in segments (the Python module's
   /// `run(steps=…)`, driver::Run::set_end_time). Throws std::invalid_argument if not positive.
@@ -137,14 +144,19 @@ class Simulation {
   }
   /// Whether the current step is an output step: a time-series row is due (every
   /// output.rows steps, and at the end).
-  bool output_due() const { return step_ % p_.output.rows == 0 || at_end(); }
+  bool output_due() const { return due(p_.output.rows, p_.output.rows_every) || at_end(); }
   /// Whether a trajectory frame is due at the current step (`stopping`: the run stops here).
   bool frame_due(bool stopping) const {
-    return p_.output.frames > 0 && (step_ % p_.output.frames == 0 || stopping);
+    const bool any = p_.output.frames > 0 || p_.output.frames_every > 0;
+    return any && (due(p_.output.frames, p_.output.frames_every) || stopping);
   }
+  /// Whether the current step is on the row / frame schedule proper (not written only because
+  /// the run stopped here): what an extended run keeps of the rows and frames it resumes after.
+  bool row_on_schedule() const { return on_schedule(p_.output.rows, p_.output.rows_every); }
+  bool frame_on_schedule() const { return on_schedule(p_.output.frames, p_.output.frames_every); }
   /// Whether a checkpoint is due at the current step (`stopping`: the run stops here).
   bool checkpoint_due(bool stopping) const {
-    return (p_.output.checkpoints > 0 && step_ % p_.output.checkpoints == 0) || stopping;
+    return due(p_.output.checkpoints, p_.output.checkpoints_every) || stopping;
   }
   /// Diagnostics of the current state (O(n²) writhe and closest approach: output steps only).
   /// With a distributed fluid every rank must call step() and observe() alike (the kinetic
@@ -155,12 +167,22 @@ class Simulation {
   StopReason stop_reason(const Observables& o) const;
 
  private:
+  /// Due at this step: every `steps` steps (0: never), or, with `every` > 0 (s), when the last
+  /// step reached or passed a multiple of `every`.
+  bool due(std::int64_t steps, double every) const;
+  /// due() from the clock alone (no previous time: after a resume): the implicit scheme lands
+  /// on the multiples, the explicit one passed one in its last step of Δt.
+  bool on_schedule(std::int64_t steps, double every) const;
+  /// The simulated time left to the next multiple of an interval in simulated time (HUGE_VAL
+  /// without one): the implicit scheme's step is capped by it.
+  double time_to_next_output() const;
   SimParams p_;
   rod::RodState rod_;
   integrate::Stepper stepper_;
   std::unique_ptr<integrate::ImplicitIntegrator> implicit_;  // time.scheme = "implicit"
   std::int64_t step_ = 0;
   double time_ = 0;            ///< s
+  double prev_time_ = 0;       ///< s, before the last step (schedules in simulated time)
   double electro_circle_ = 0;  ///< E_electro of the initial circle, g Å² s⁻²
 };
 

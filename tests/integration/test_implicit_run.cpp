@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "io/checkpoint.hpp"
+#include "io/h5md.hpp"
 #include "run_helpers.hpp"
 
 using namespace ibrod;
@@ -111,4 +112,43 @@ TEST(ImplicitRun, BenchSchemesEndsWithBothRates) {
   EXPECT_GT(im, ex);  // 20× the step at a cost of about one explicit step each
   EXPECT_EQ(out.find('\n', pos), out.size() - 1) << "not the last line:\n" << out;
   fs::remove_all(root);
+}
+
+// issue 14, the output schedule in simulated time: with output.every_us the implicit scheme's rows
+// fall on the multiples of the interval (its steps are shortened to land there), and a run
+// extended by raising only time.t_end_us to a later multiple is bitwise the uninterrupted one.
+TEST(ImplicitRun, RowsInSimulatedTimeFallOnTheirMultiplesAndAnExtensionIsBitwise) {
+  const fs::path root = fresh_dir("implicit_every_us");
+  const std::string cfg =
+      "[grid]\nn = 32\nbox_A = 362.5\n[rod]\nbase_pairs = 150\nexcess_link = 3\n"
+      "[time]\nscheme = \"implicit\"\ndt_ns = 3\nt_end_us = 0.2\n"
+      "[output]\nevery_us = 0.01\nframe_every_us = 0.04\ncheckpoint_every_steps = 0\n"
+      "[run]\nthreads = 2\nfftw_measure = false\n";
+  std::ofstream(root / "long.toml") << cfg;
+  Exit e = run_ibrod({"run", (root / "long.toml").string(), "-o", (root / "ref").string()},
+                     root / "ref.log");
+  ASSERT_EQ(e.code, 0) << e.output;
+  const std::vector<double> t = column(root / "ref" / "timeseries.csv", "time_us");
+  ASSERT_EQ(t.size(), 21u);  // t = 0, 0.01, …, 0.2
+  for (std::size_t i = 0; i < t.size(); ++i) EXPECT_NEAR(t[i], 0.01 * double(i), 1e-12) << i;
+  const std::vector<double> steps = column(root / "ref" / "timeseries.csv", "step");
+  EXPECT_GT(steps.back(), 2.0 * 20);  // several steps a row: Δt ≤ 3 ns, rows 10 ns apart
+  const io::H5mdSeries fr = io::read_h5md_series(root / "ref" / "trajectory.h5", "position");
+  ASSERT_EQ(fr.time_us.size(), 6u);  // frames at 0, 0.04, …, 0.2 µs
+  for (std::size_t i = 0; i < fr.time_us.size(); ++i)
+    EXPECT_NEAR(fr.time_us[i], 0.04 * double(i), 1e-12) << i;
+
+  std::ofstream(root / "short.toml")
+      << std::string(cfg).replace(cfg.find("t_end_us = 0.2"), 14, "t_end_us = 0.08");
+  e = run_ibrod({"run", (root / "short.toml").string(), "-o", (root / "ext").string()},
+                root / "a.log");
+  ASSERT_EQ(e.code, 0) << e.output;
+  e = run_ibrod({"run", "--resume", (root / "ext").string(), "--set", "time.t_end_us=0.2"},
+                root / "b.log");
+  ASSERT_EQ(e.code, 0) << e.output;
+  EXPECT_THAT(e.output, HasSubstr("extending the run"));
+  EXPECT_EQ(read_file(root / "ext" / "timeseries.csv"), read_file(root / "ref" / "timeseries.csv"));
+  EXPECT_EQ(read_file(root / "ext" / "final_state.csv"),
+            read_file(root / "ref" / "final_state.csv"));
+  if (!HasFailure()) fs::remove_all(root);
 }
