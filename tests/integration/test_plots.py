@@ -243,6 +243,12 @@ class SweepReports(unittest.TestCase):
         self.assertIn("- Cs = 0.1 M: stable up to ΔLk = 1, unstable from ΔLk = 3: "
                       "the threshold lies in (1, 3]", part)
         self.assertNotIn("## Perturbation sampling", md)  # a ΔLk sweep is no sampling
+        # the probe's recorded length is the simulated time it integrated: 0.2 µs to within one
+        # adaptive step (≤ 2 ns), not steps × the last Δt
+        for r in rows:
+            with open(os.path.join(r["run"], "summary.json")) as f:
+                for t in json.load(f)["stability_tests"]:
+                    self.assertLessEqual(abs(t["probe_time_us"] - 0.2), 0.0021, t)
 
 
 if __name__ == "__main__":
