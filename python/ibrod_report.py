@@ -16,6 +16,13 @@ Writes into REPORT_DIR:
                       per Cs
   shapes.png          contact sheet: every run's final shape (rows ΔLk, columns Cs), its time,
                       class and stop reason on the tile
+  sampling_N.png      for each group of runs that differ only in their perturbation (a sweep
+                      over rod.perturbation_random.seed at one ΔLk, Cs): one picture per final
+                      shape class, with its count and energy (report.md: "Perturbation sampling")
+
+report.md also says, for each (ΔLk, Cs), whether the twisted circle was stable as the stability
+test decided (summary.json stability_tests), and brackets the threshold ΔLk per Cs. The grouping
+and stability rules are in python/ibrod_study.py.
 
 ΔLk and Cs come from each run's config.toml (rod.excess_link, solvent.salt_M); the numbers from
 summary.json after `ibrod analyze` (with --ibrod BINARY the script runs `BINARY analyze` on every
@@ -41,6 +48,8 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from ibrod_plot import Run  # noqa: E402
+from ibrod_study import (CIRCLE_WRITHE, circle_stability, class_census,  # noqa: E402
+                         perturbation_label, sampling_groups, stability_bracket)
 
 DASH = "—"
 NOT_ANALYSED = "not analysed"
@@ -107,6 +116,30 @@ def tile_caption(run):
     return f"t = {fmt(final(run, 'time_us'))} µs, {shape}, {stop}"
 
 
+def draw_tile(fig, nr, nc, idx, run, view):
+    """One tile: the run's rendered picture, else a 3-D line drawing of final_state.csv."""
+    pic = final_picture(run, view) if run is not None else None
+    if run is not None and pic is None:
+        ax = fig.add_subplot(nr, nc, idx, projection="3d")
+        draw_final_state_3d(ax, run)
+        return ax
+    ax = fig.add_subplot(nr, nc, idx)
+    ax.set_xticks([])
+    ax.set_yticks([])
+    for sp in ax.spines.values():
+        sp.set_visible(False)
+    if pic is not None:
+        ax.imshow(mpimg.imread(pic))
+    else:
+        ax.text(0.5, 0.5, DASH, ha="center", va="center", transform=ax.transAxes)
+    return ax
+
+
+def put_caption(ax, text):
+    put = ax.text2D if hasattr(ax, "text2D") else ax.text  # text2D on a 3-D axes
+    put(0.5, -0.02, text, ha="center", va="top", fontsize="small", transform=ax.transAxes)
+
+
 def contact_sheet(grid, dlks, css, view, out):
     nr, nc = len(dlks), len(css)
     fig = plt.figure(figsize=(3.0 * nc + 0.6, 3.4 * nr + 0.4))
@@ -114,28 +147,13 @@ def contact_sheet(grid, dlks, css, view, out):
         for j, cs in enumerate(css):
             runs = grid.get((dlk, cs), [])
             idx = i * nc + j + 1
-            pic = final_picture(runs[0], view) if runs else None
-            if runs and pic is None:
-                ax = fig.add_subplot(nr, nc, idx, projection="3d")
-                draw_final_state_3d(ax, runs[0])
-            else:
-                ax = fig.add_subplot(nr, nc, idx)
-                ax.set_xticks([])
-                ax.set_yticks([])
-                for sp in ax.spines.values():
-                    sp.set_visible(False)
-                if pic is not None:
-                    ax.imshow(mpimg.imread(pic))
-                else:
-                    ax.text(0.5, 0.5, DASH, ha="center", va="center", transform=ax.transAxes)
+            ax = draw_tile(fig, nr, nc, idx, runs[0] if runs else None, view)
             title = f"ΔLk = {dlk}, Cs = {cs:g} M"
             if len(runs) > 1:
                 title += f" (+{len(runs) - 1})"
             ax.set_title(title, fontsize="small")
-            if runs:  # text2D on a 3-D axes
-                put = ax.text2D if hasattr(ax, "text2D") else ax.text
-                put(0.5, -0.02, tile_caption(runs[0]), ha="center", va="top",
-                    fontsize="small", transform=ax.transAxes)
+            if runs:
+                put_caption(ax, tile_caption(runs[0]))
     fig.tight_layout()
     fig.savefig(out, dpi=80)
     plt.close(fig)
@@ -290,6 +308,107 @@ def transients_cell(r):
                      for x in tr)
 
 
+def sampling_sheet(census, view, out):
+    """One tile per shape class of a sampling group: the representative's picture, the count and
+    the representative's final energy."""
+    nc = len(census)
+    fig = plt.figure(figsize=(3.0 * nc + 0.6, 3.6))
+    for j, e in enumerate(census):
+        rep = e["representative"]
+        ax = draw_tile(fig, 1, nc, j + 1, rep, view)
+        ax.set_title(f"{e['class']} × {e['count']}", fontsize="small")
+        done = "" if rep.finished else f", {NOT_FINISHED}"
+        put_caption(ax, f"{perturbation_label(rep)}: E_total = {fmt(final(rep, 'E_total_kT'), 5)} kT"
+                        f"{done}")
+    fig.tight_layout()
+    fig.savefig(out, dpi=80)
+    plt.close(fig)
+
+
+def energy_range(e):
+    if e["E_min_kT"] is None:
+        return DASH
+    if fmt(e["E_min_kT"], 5) == fmt(e["E_max_kT"], 5):
+        return fmt(e["E_min_kT"], 5)
+    return f"{fmt(e['E_min_kT'], 5)} … {fmt(e['E_max_kT'], 5)}"
+
+
+def sampling_section(groups, view, outdir):
+    """report.md lines and figures of the perturbation-sampling groups."""
+    md = []
+    for i, group in enumerate(groups, 1):
+        r0 = group[0]
+        census = class_census(group)
+        name = f"sampling_{i}.png"
+        sampling_sheet(census, view, os.path.join(outdir, name))
+        unfinished = sum(1 for r in group if not r.finished)
+        md += [f"## Perturbation sampling: ΔLk = {fmt(r0.excess_link)}, Cs = {fmt(r0.salt_M)} M", "",
+               f"{len(group)} runs that differ only in their perturbation (`rod.perturbation`, "
+               f"`rod.perturbation_random`), {len(census)} final shape class"
+               f"{'es' if len(census) != 1 else ''}"
+               + (f"; {unfinished} run{'s' if unfinished != 1 else ''} did not reach equilibrium "
+                  "(counted by the class of the state where they stopped)" if unfinished else "")
+               + ". Energies: final E_total; the picture shows the class's run of lowest energy "
+               "among those at equilibrium.", "",
+               "| class | runs | at equilibrium | perturbations | E_total (kT) | Wr | picture |",
+               "|---|---|---|---|---|---|---|"]
+        for e in census:
+            rep = e["representative"]
+            wr = (fmt(e["writhe_min"], 3) if fmt(e["writhe_min"], 3) == fmt(e["writhe_max"], 3)
+                  else f"{fmt(e['writhe_min'], 3)} … {fmt(e['writhe_max'], 3)}")
+            md.append(f"| {e['class']} | {e['count']} | {e['equilibrium']} | "
+                      f"{', '.join(e['labels'])} | {energy_range(e)} | {wr} | "
+                      f"{perturbation_label(rep)} ({rep.name}) |")
+        md += ["", f"![Perturbation sampling {i}]({name})", ""]
+    return md
+
+
+def stability_cell(r):
+    v = circle_stability(r)
+    if v["verdict"] in ("stable", "unstable"):
+        de = v["E_after_kT"] - v["E_before_kT"]
+        tol = r.config.get("time", {}).get("stability_tolerance_kT")
+        text = (f"{v['verdict']} (ΔE {de:+.3g} kT"
+                + (f", tolerance {fmt(tol)} kT" if tol is not None else "")
+                + f"; probe at {fmt(v['time_us'])} µs, seed {v['seed']}, "
+                f"{fmt(v['amplitude_rad'])} rad")
+        if v["verdict"] == "unstable":
+            text += f"; Wr → {fmt(v['writhe_after'], 3)}"
+        return text + ")"
+    if v["verdict"] == "left_circle":
+        return f"unstable: left the circle untested at {fmt(v['time_us'])} µs"
+    if v["verdict"] == "perturbed_away":
+        return f"undecided: perturbed away from the circle before a test ({fmt(v['time_us'])} µs)"
+    return f"not tested: {v['reason']}"
+
+
+def stability_lines(grid, dlks, css):
+    """The bracket of the threshold ΔLk per Cs."""
+    lines = []
+    for cs in css:
+        verdicts = {}
+        for dlk in dlks:
+            vs = {circle_stability(r)["verdict"] for r in grid.get((dlk, cs), [])}
+            if len(vs) == 1:
+                verdicts[dlk] = vs.pop()
+            elif vs:  # runs at one ΔLk that disagree: neither bound
+                verdicts[dlk] = "mixed"
+        lo, hi, ok = stability_bracket(verdicts)
+        if lo is None and hi is None:
+            text = "no run decides"
+        elif not ok:
+            text = (f"not one threshold: stable up to ΔLk = {lo}, but unstable already at "
+                    f"ΔLk = {hi}")
+        elif hi is None:
+            text = f"stable up to ΔLk = {lo} (no unstable run: the threshold lies above)"
+        elif lo is None:
+            text = f"unstable from ΔLk = {hi} (no stable run: the threshold lies below)"
+        else:
+            text = f"stable up to ΔLk = {lo}, unstable from ΔLk = {hi}: the threshold lies in ({lo}, {hi}]"
+        lines.append(f"- Cs = {cs:g} M: {text}")
+    return lines
+
+
 def maybe_run(binary, args):
     r = subprocess.run([binary] + args, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     if r.returncode != 0:
@@ -303,7 +422,7 @@ def write_runs_csv(runs, path):
               "E_kinetic_kT", "closest_approach_A", "shape", "loops", "crossings",
               "interwound_length_A", "writhe_convergence_time_us", "relaxation_time_table_us",
               "relaxation_time_method", "relaxation_time_us", "relaxation_time_contacts_us",
-              "transients", "kinetic_power_law_exponent"]
+              "transients", "kinetic_power_law_exponent", "perturbation", "circle_stability"]
     with open(path, "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(fields)
@@ -319,7 +438,8 @@ def write_runs_csv(runs, path):
                         s.get("writhe_convergence_time_us"), s.get("relaxation_time_table_us"),
                         s.get("relaxation_time_method"), s.get("relaxation_time_us"),
                         s.get("relaxation_time_contacts_us"),
-                        len(tr) if tr is not None else None, s.get("kinetic_power_law_exponent")])
+                        len(tr) if tr is not None else None, s.get("kinetic_power_law_exponent"),
+                        perturbation_label(r), circle_stability(r)["verdict"]])
 
 
 def main(argv=None):
@@ -403,7 +523,18 @@ def main(argv=None):
            "", "## Transient states", "",
            "Local minima of E_K on plateaus of the total energy: time, plateau energy and (with "
            "`analyze --frames`) the shape class there.", "",
-           table(grid, dlks, css, transients_cell), ""]
+           table(grid, dlks, css, transients_cell), "",
+           "## Stability of the twisted circle", "",
+           "Whether the circle was stable, as the stability test decided (`time.stability_*`, "
+           "summary.json `stability_tests`): the first test, when it found the rod still "
+           f"circular (|Wr| < {CIRCLE_WRITHE}); ΔE is the change of E_total over the probe "
+           "(a fall: unstable). \"left the circle untested\": a run without perturbation whose "
+           f"|Wr| grew past {CIRCLE_WRITHE} before E_K fell below `time.stop_kinetic_kT` "
+           "(unstable without the test's help); \"undecided\": a perturbed run did so (the "
+           "perturbation may have been larger than the circle's basin).", "",
+           table(grid, dlks, css, stability_cell), ""] + stability_lines(grid, dlks, css) + [""]
+    groups = sampling_groups(runs)
+    md += sampling_section(groups, a.view, a.output)
     if unanalysed:
         md += ["Not analysed (run `ibrod analyze DIR`, or pass `--ibrod BINARY`): " +
                ", ".join(unanalysed), ""]

@@ -251,7 +251,7 @@ StopReason Run::State::test_stability(StopReason candidate) {
   tests.push_back({{"step", o.step},
                    {"time_us", o.time_us},
                    {"probe_steps", o.steps},
-                   {"probe_time_us", double(o.steps) * s.dt() / 1e-6},
+                   {"probe_time_us", o.duration_us},
                    {"amplitude_rad", probe.amplitude},
                    {"seed", probe.seed + tests.size()},
                    {"E_total_before_kT", o.E_before_kT},

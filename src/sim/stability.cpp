@@ -66,6 +66,7 @@ ProbeOutcome probe_stability(Simulation& sim, const StabilityProbe& p, std::uint
     sim.step();
     ++o.steps;
   } while (sim.time() < t_end - 0.5 * sim.dt());
+  o.duration_us = (sim.time() - saved_time) / 1e-6;
   const Observables after = sim.observe();
   o.E_after_kT = after.E_total_kT;
   o.writhe_after = after.writhe;

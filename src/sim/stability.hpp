@@ -39,6 +39,7 @@ struct ProbeOutcome {
   std::int64_t step = 0;   ///< the step the probe started at
   double time_us = 0;      ///< its time
   std::int64_t steps = 0;  ///< steps integrated
+  double duration_us = 0;  ///< time integrated (≥ the probe time; adaptive Δt: not steps × Δt)
   double E_before_kT = 0, E_after_kT = 0;
   double writhe_before = 0, writhe_after = 0;
 };

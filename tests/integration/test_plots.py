@@ -3,7 +3,10 @@
 100 base pairs, 300 steps) analysed with `ibrod analyze` (one with --frames), one of them drawn
 with `ibrod render`, then python/ibrod_plot.py and python/ibrod_report.py on them. Both runs stop
 at their end time, not at equilibrium: analyze and the report must say "not finished" and give no
-writhe convergence time or τ.
+writhe convergence time or τ. Then two tiny sweeps (implicit scheme, 16³): three random-
+perturbation seeds at one (ΔLk, Cs), whose report groups the final states by shape class, and
+ΔLk = 1, 3 from the unperturbed circle, whose report says which circle the stability test found
+stable and brackets the threshold.
 
     /usr/bin/python3 tests/integration/test_plots.py /path/to/ibrod
 
@@ -13,6 +16,7 @@ passes.
 import csv
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -191,6 +195,102 @@ class PlotsAndReport(unittest.TestCase):
         with open(os.path.join(rep2, "report.md")) as f:
             self.assertIn("## Relaxation time", f.read())
         self.assertNotEqual(sh(BINARY, "report", check=False).returncode, 0)  # no run: usage
+
+
+SWEEP_BASE = """[grid]
+n = 16
+box_A = 200.0
+[time]
+scheme = "implicit"
+dt_ns = 2.0
+t_end_us = {t_end}
+stop_kinetic_kT = 1e-8
+stability_probe_us = 0.2
+[rod]
+base_pairs = 100
+excess_link = {dlk}
+perturbation = []
+{random}
+[output]
+every_steps = 10
+frame_every_steps = 0
+checkpoint_every_steps = 0
+[run]
+threads = 1
+fftw_measure = false
+[sweep]
+{sweep}
+"""
+
+
+class SweepReports(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.mkdtemp(prefix="ibrod_sweep_report_")
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.tmp, ignore_errors=True)
+
+    def sweep(self, name, text):
+        path = os.path.join(self.tmp, f"{name}.toml")
+        with open(path, "w") as f:
+            f.write(text)
+        out = os.path.join(self.tmp, name)
+        sh(BINARY, "sweep", path, "-o", out, "-j", "2")
+        runs = sorted(os.path.join(out, d) for d in os.listdir(out)
+                      if os.path.isfile(os.path.join(out, d, "summary.json")))
+        rep = os.path.join(self.tmp, name + "_report")
+        sh(BINARY, "report", *runs, "-o", rep)
+        with open(os.path.join(rep, "report.md")) as f:
+            md = f.read()
+        with open(os.path.join(rep, "runs.csv")) as f:
+            rows = list(csv.DictReader(f))
+        return rep, md, rows
+
+    def test_perturbation_sampling_groups_the_final_states_by_class(self):
+        rep, md, rows = self.sweep("seeds", SWEEP_BASE.format(
+            t_end=0.4, dlk=4, random="perturbation_random = { modes = 6, amplitude = 1.0 }",
+            sweep='"rod.perturbation_random.seed" = [1, 2, 3]'))
+        self.assertEqual(len(rows), 3)
+        part = md.split("## Perturbation sampling: ΔLk = 4, Cs = 0.1 M")[1].split("\n## ")[0]
+        self.assertIn("3 runs that differ only in their perturbation", part)
+        # one table row per class, the counts those of the runs' classes, all seeds listed once
+        classes = {}
+        for r in rows:
+            classes[r["shape"]] = classes.get(r["shape"], 0) + 1
+        table = [l for l in part.splitlines() if l.startswith("| ") and not l.startswith("| class")]
+        self.assertEqual(len(table), len(classes), part)
+        for line in table:
+            cells = [c.strip() for c in line.strip("|").split("|")]
+            self.assertEqual(int(cells[1]), classes[cells[0]], line)
+        seeds = sorted(s.strip() for l in table for s in l.split("|")[4].split(","))
+        self.assertEqual(seeds, ["seed 1", "seed 2", "seed 3"])
+        img = mpimg.imread(os.path.join(rep, "sampling_1.png"))
+        self.assertEqual(img.ndim, 3)
+        self.assertGreater(img.shape[1], img.shape[0] * 0.8 * len(classes))  # one tile per class
+
+    def test_circle_stability_brackets_the_threshold(self):
+        rep, md, rows = self.sweep("circle", SWEEP_BASE.format(
+            t_end=0.3, dlk=1, random="", sweep='"rod.excess_link" = [1, 3]'))
+        verdict = {int(r["excess_link"]): r["circle_stability"] for r in rows}
+        self.assertEqual(verdict, {1: "stable", 3: "unstable"})
+        part = md.split("## Stability of the twisted circle")[1].split("\n## ")[0]
+        # ΔE over the probe: within the tolerance (1e-3 kT) when stable, a fall beyond it when not
+        d1 = re.search(r"\| 1 \| stable \(ΔE ([-+][0-9.e+-]+) kT, tolerance 0.001 kT", part)
+        d3 = re.search(r"\| 3 \| unstable \(ΔE ([-+][0-9.e+-]+) kT, tolerance 0.001 kT", part)
+        self.assertTrue(d1 and d3, part)
+        self.assertGreater(float(d1.group(1)), -1e-3)
+        self.assertLess(float(d3.group(1)), -1e-3)
+        self.assertIn("- Cs = 0.1 M: stable up to ΔLk = 1, unstable from ΔLk = 3: "
+                      "the threshold lies in (1, 3]", part)
+        self.assertNotIn("## Perturbation sampling", md)  # a ΔLk sweep is no sampling
+        # the probe's recorded length is the simulated time it integrated: 0.2 µs to within one
+        # adaptive step (≤ 2 ns), not steps × the last Δt
+        for r in rows:
+            with open(os.path.join(r["run"], "summary.json")) as f:
+                for t in json.load(f)["stability_tests"]:
+                    self.assertLessEqual(abs(t["probe_time_us"] - 0.2), 0.0021, t)
 
 
 if __name__ == "__main__":

@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <set>
 
 #include "core/error.hpp"
 #include "driver/sweep_runner.hpp"
@@ -154,4 +155,45 @@ TEST(Sweep, TheReferenceExampleIsTheEighteenReferenceRuns) {
         (fs::path(IBROD_SOURCE_DIR) / "examples" / "reference" / name).string());
     EXPECT_EQ(config::to_toml(pt.config), config::to_toml(ref)) << pt.name;
   }
+}
+
+// examples/sweep_perturbations.toml and docs/example_report/sampling/sweep.toml sample random
+// perturbations at one (ΔLk, Cs): their points differ only in the seed (what `ibrod report`
+// groups as a sampling, python/ibrod_study.py).
+TEST(Sweep, TheSamplingExamplesDifferOnlyInTheSeed) {
+  for (const fs::path& f : {fs::path("examples") / "sweep_perturbations.toml",
+                            fs::path("docs") / "example_report" / "sampling" / "sweep.toml"}) {
+    const auto sw = driver::load_sweep(fs::path(IBROD_SOURCE_DIR) / f);
+    ASSERT_GE(sw.points.size(), 6u) << f;
+    std::set<std::uint64_t> seeds;
+    config::Config first = sw.points.front().config;
+    first.rod_perturbation_random.seed = 0;
+    for (const auto& pt : sw.points) {
+      EXPECT_GT(pt.config.rod_perturbation_random.modes, 0) << f;
+      EXPECT_GT(pt.config.rod_perturbation_random.amplitude, 0) << f;
+      EXPECT_TRUE(pt.config.rod_perturbation.empty()) << f;
+      EXPECT_EQ(pt.config.time_scheme, "implicit") << f;
+      seeds.insert(pt.config.rod_perturbation_random.seed);
+      config::Config c = pt.config;
+      c.rod_perturbation_random.seed = 0;
+      EXPECT_EQ(config::to_toml(c), config::to_toml(first)) << f << " " << pt.name;
+    }
+    EXPECT_EQ(seeds.size(), sw.points.size()) << f;
+  }
+}
+
+// examples/sweep_circle_stability.toml: the unperturbed circle over ΔLk at low salt, with the
+// stability test on (the report's verdict comes from it).
+TEST(Sweep, TheCircleStabilityExampleIsTheUnperturbedCircleAtLowSalt) {
+  const auto sw =
+      driver::load_sweep(fs::path(IBROD_SOURCE_DIR) / "examples" / "sweep_circle_stability.toml");
+  std::set<int> dlks;
+  for (const auto& pt : sw.points) {
+    EXPECT_TRUE(pt.config.rod_perturbation.empty()) << pt.name;
+    EXPECT_EQ(pt.config.rod_perturbation_random.modes, 0) << pt.name;
+    EXPECT_TRUE(pt.config.time_stability_test) << pt.name;
+    EXPECT_LE(pt.config.solvent_salt_M, 0.01) << pt.name;
+    dlks.insert(pt.config.rod_excess_link);
+  }
+  EXPECT_GE(dlks.size(), 3u);
 }
