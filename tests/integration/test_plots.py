@@ -135,6 +135,12 @@ class PlotsAndReport(unittest.TestCase):
         mp4 = os.path.join(self.b, "render", "rod_oblique.mp4")
         if shutil.which("ffmpeg"):
             self.assertTrue(os.path.getsize(mp4) > 0)
+            # the MP4 holds every frame: ffprobe counts the decoded frames of its video stream
+            if shutil.which("ffprobe"):
+                n = sh("ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0",
+                       "-show_entries", "stream=nb_read_frames,width,height", "-of", "csv=p=0",
+                       mp4).stdout.strip()
+                self.assertEqual(n, "48,40,16", n)  # width, height, frames
         else:
             self.assertIn("ffmpeg not found", r.stdout)
             self.assertFalse(os.path.exists(mp4))
