@@ -135,6 +135,11 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
   std::vector<float> shade(depth.size(), 0.0f);
   std::vector<std::uint8_t> on_stripe(depth.size(), 0);
   std::vector<float> param(style.colouring == Colouring::stripe ? 0 : depth.size(), 0.0f);
+  // arc length of the nearest hit's axis point from X_0, for the outlines
+  std::vector<float> arc(depth.size(), 0.0f);
+  std::vector<double> cum(n + 1, 0.0);
+  for (std::size_t k = 0; k < n; ++k) cum[k + 1] = cum[k] + (X[(k + 1) % n] - X[k]).norm();
+  const double arc_total = cum[n];
   double z_lo = std::numeric_limits<double>::infinity(), z_hi = -z_lo;
   for (const auto& x : X) z_lo = std::min(z_lo, x.z()), z_hi = std::max(z_hi, x.z());
 
@@ -183,6 +188,7 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
         // shade with the same ⟂ normal (Phong-like smoothing across the joints)
         const Vec3 ns = np.norm() > 1e-12 ? Vec3(np.normalized()) : nrm;
         shade[idx] = float(style.ambient + (1 - style.ambient) * std::max(0.0, ns.dot(light)));
+        arc[idx] = float(cum[k] + hit.h * len);
         if (style.colouring == Colouring::along)
           param[idx] = float((double(k) + hit.h) / double(n));
         else if (style.colouring == Colouring::height)
@@ -192,7 +198,15 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
   }
 
   // outlines: darken the nearer side of every occlusion boundary (a neighbour within about one
-  // pixel is background or lies behind by more than the radius), so crossings read as such
+  // pixel is background, or lies behind by more than the radius on a part of the rod more than
+  // style.outline_arc diameters away along it), so crossings read as such; where the tube turns
+  // toward the viewer in front of its own continuation there is no line across it, which would
+  // look like the cap of a free end
+  const double arc_gap = style.outline_arc * diameter;
+  const auto far_along = [&](float s1, float s2) {
+    const double ds = std::abs(double(s1) - double(s2));
+    return std::min(ds, arc_total - ds) > arc_gap;
+  };
   if (style.outline_darken < 1) {
     const int reach = S;
     std::vector<std::uint8_t> edge(depth.size(), 0);
@@ -204,7 +218,9 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
           const int nx[4] = {px - d, px + d, px, px}, ny[4] = {py, py, py - d, py + d};
           for (int q = 0; q < 4; ++q) {
             if (nx[q] < 0 || ny[q] < 0 || nx[q] >= W || ny[q] >= H) continue;
-            if (depth[std::size_t(ny[q]) * std::size_t(W) + std::size_t(nx[q])] > depth[idx] + R)
+            const std::size_t nq = std::size_t(ny[q]) * std::size_t(W) + std::size_t(nx[q]);
+            if (!std::isfinite(depth[nq]) ||
+                (depth[nq] > depth[idx] + R && far_along(arc[nq], arc[idx])))
               edge[idx] = 1;
           }
         }

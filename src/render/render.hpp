@@ -3,7 +3,9 @@
 // on the side the director D¹ points to, so that twist shows as a helical stripe. Software
 // ray casting of one capsule (cylinder + spherical caps) per segment X_k → X_{k+1} (X_n = X_0)
 // under an orthographic camera, nearest hit per pixel (a z-buffer), Lambert + ambient shading,
-// dark outlines where one part of the tube passes in front of another, S×S supersampling. Knows
+// dark outlines on the silhouette and where one part of the tube passes in front of a distant
+// part (not where it turns toward the viewer in front of its own continuation), S×S
+// supersampling. Knows
 // points and directors only.
 #include <span>
 #include <string>
@@ -44,8 +46,11 @@ struct Style {
   double ambient = 0.3;      ///< shade = ambient + (1 − ambient) max(0, n · light)
   double outline_darken = 0.45;  ///< shade factor of a ≈ 1 pixel outline on the near side of
                                  ///< occlusion boundaries (1: no outlines)
-  int supersample = 3;           ///< S×S rays per pixel, averaged
-  double margin = 0.04;          ///< free border on each side, fraction of the smaller image side
+  double outline_arc = 2;  ///< an occluded neighbour gets an outline only when it is more than this
+                           ///< many diameters away along the rod (a part that turns toward the
+                           ///< viewer in front of its own continuation has none)
+  int supersample = 3;     ///< S×S rays per pixel, averaged
+  double margin = 0.04;    ///< free border on each side, fraction of the smaller image side
   double depth_cue = 0.35;  ///< the farthest tube surface is blended this far toward the background
   std::vector<std::string> labels;  ///< lines written at the top left (a band the rod stays out of)
   bool scale_bar = false;           ///< a bar of a round length at the bottom left, labelled in Å

@@ -335,6 +335,53 @@ TEST(Render, DepthCueLightensTheFarSideAndColourMapsFollowTheRod) {
   EXPECT_GT(mid.g, mid.b);
 }
 
+TEST(Render, ATubeTurningTowardTheViewerHasNoOutlineAcrossItLikeAFreeEnd) {
+  // a 200 × 60 Å rectangle standing in the x–z plane (points 5 Å apart), seen from above with a
+  // 15° tilt: its upper (near) edge hides most of the lower one, and at the corners the tube
+  // turns away from the viewer behind its own near end. Inside the rod's silhouette the outline
+  // may only mark the near edge passing over the far one (one horizontal line); a line across
+  // the tube at a corner, where the near edge meets its own continuation, would draw the cap of
+  // a free end.
+  std::vector<Vec3> X, d1;
+  const auto edge = [&](Vec3 a, Vec3 b) {
+    const int m = int(std::lround((b - a).norm() / 5));
+    for (int i = 0; i < m; ++i)
+      X.push_back(a + (b - a) * (double(i) / m)), d1.emplace_back(0, 1, 0);
+  };
+  edge({-100, 0, 0}, {100, 0, 0});
+  edge({100, 0, 0}, {100, 0, 60});
+  edge({100, 0, 60}, {-100, 0, 60});
+  edge({-100, 0, 60}, {-100, 0, 0});
+  const double tilt = 15 * kPi / 180;
+  const View view{"tilted", Vec3(0, std::sin(tilt), -std::cos(tilt)), Vec3(0, 1, 0)};
+  Style plain, outlined;
+  plain.outline_darken = 1;
+  const int w = 400, h = 200;
+  const Image a = render_rod(X, d1, 20.0, view, w, h, plain);
+  const Image b = render_rod(X, d1, 20.0, view, w, h, outlined);
+  const auto near_background = [&](int x, int y) {
+    for (int j = -2; j <= 2; ++j)
+      for (int i = -2; i <= 2; ++i)
+        if (x + i >= 0 && y + j >= 0 && x + i < w && y + j < h && is_background(a.at(x + i, y + j)))
+          return true;
+    return false;
+  };
+  int silhouette = 0, inside = 0, y_lo = h, y_hi = -1;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      if (!(a.at(x, y) == b.at(x, y))) {
+        if (near_background(x, y)) {
+          ++silhouette;
+        } else {
+          ++inside;
+          y_lo = std::min(y_lo, y), y_hi = std::max(y_hi, y);
+        }
+      }
+  EXPECT_GT(silhouette, 500);  // the silhouette is outlined
+  EXPECT_GT(inside, 200);      // so is the near edge over the far one, across the picture
+  EXPECT_LE(y_hi - y_lo, 1);   // and nothing else: no line across the tube at the corners
+}
+
 TEST(Render, BadInputThrows) {
   const Ring ring(50, 10.0);
   const std::vector<Vec3> short_d1(ring.d1.begin(), ring.d1.begin() + 10);
