@@ -32,9 +32,17 @@ View standard_view(const std::string& name);
 std::vector<std::string> standard_view_names();
 
 /// What colours the tube's body: one colour with the D¹ stripe in a second; or a colour map
-/// along the rod (point index: start blue → end red) or of the lab height z, with the stripe a
-/// darker shade of the body.
-enum class Colouring { stripe, along, height };
+/// along the rod (point index: start blue → end red), of the lab height z, or of the twist
+/// density (twist_density, the picture's lowest blue → highest red; uniform: green), with the
+/// stripe a darker shade of the body.
+enum class Colouring { stripe, along, height, twist };
+
+/// The twist density of each segment X_k → X_{k+1} (X_n = X_0), in radians per unit of X's
+/// length: D¹_k (made ⟂ to the vertex tangent t_k, central differences) parallel-transported to
+/// t_{k+1} by the smallest rotation, then its signed angle (right-handed about t_{k+1}) to
+/// D¹_{k+1}, over the segment's length (0 where the tangent turns by more than ~172°). X.size() ≥ 2
+/// and d1.size() = X.size(), else std::invalid_argument.
+std::vector<double> twist_density(std::span<const Vec3> X, std::span<const Vec3> d1);
 
 struct Style {
   Colouring colouring = Colouring::stripe;

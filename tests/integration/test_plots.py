@@ -13,6 +13,7 @@ passes.
 import csv
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -122,6 +123,20 @@ class PlotsAndReport(unittest.TestCase):
         self.png(os.path.join(self.a, "render", "rod_side_t0.0300.png"))
         r = sh(BINARY, "render", self.a, "--time", "0.01", "--views", "front", "--size", "32x32")
         self.assertNotIn("warning", r.stdout)
+        # --colour twist: the final state coloured by twist density, its range printed. The mean
+        # twist density is 360° Tw / L with Tw = ΔLk − Wr (the rod is intrinsically untwisted):
+        # it lies in the printed range
+        r = sh(BINARY, "render", self.a, "--views", "bottom", "--size", "64x64", "--colour", "twist")
+        m = re.search(r"twist colour from (\S+) \(blue\) to (\S+) \(red\) deg/nm", r.stdout)
+        self.assertIsNotNone(m, r.stdout)
+        lo, hi = float(m.group(1)), float(m.group(2))
+        import numpy as np
+        fs = np.genfromtxt(os.path.join(self.a, "final_state.csv"), delimiter=",", names=True)
+        p = np.column_stack([fs["x_A"], fs["y_A"], fs["z_A"]])
+        length_nm = np.linalg.norm(np.roll(p, -1, axis=0) - p, axis=1).sum() / 10
+        ts = np.genfromtxt(os.path.join(self.a, "timeseries.csv"), delimiter=",", names=True)
+        mean = 360 * (2 - ts["writhe"][-1]) / length_nm
+        self.assertTrue(0 < lo < mean < hi, (lo, mean, hi))
 
     def test_1b_movie(self):
         # every frame of trajectory.h5 (16: steps 0, 20, …, 300) from the first view, one scale;
