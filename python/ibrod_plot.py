@@ -180,12 +180,12 @@ def figure_runs(runs, logt=False, title=None):
         tc = s.get("writhe_convergence_time_us")  # null for a run that did not finish
         if tc is not None:
             ax_w.axvline(tc, color=c, linestyle=":", linewidth=1)
-            marks["dotted: writhe convergence time"] = Line2D([], [], color="k", linestyle=":",
+            marks["writhe convergence time"] = Line2D([], [], color="k", linestyle=":",
                                                               linewidth=1)
         for tr in s.get("transients") or []:
             ax_e.plot(tr["time_us"], tr["E_total_kT"], "o", mfc="none", color=c)
             ax_k.plot(tr["time_us"], tr["E_kinetic_kT"], "o", mfc="none", color=c)
-            marks["○ transient state"] = Line2D([], [], color="k", marker="o", mfc="none",
+            marks["transient state"] = Line2D([], [], color="k", marker="o", mfc="none",
                                                 linestyle="none")
         tau, fit = s.get("relaxation_time_us"), s.get("relaxation_fit")
         if tau and fit:

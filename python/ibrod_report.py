@@ -230,8 +230,8 @@ def against_excess_link(grid, dlks, css, out):
     handles += [Line2D([], [], color="k", marker="o", linestyle="none"),
                 Line2D([], [], color="k", marker="o", mfc="none", linestyle="none"),
                 Line2D([], [], color="k")]
-    texts += ["● a run, finished", "○ a run, not finished",
-              "line: mean of the runs at one (ΔLk, Cs)"]
+    texts += ["a run, finished", "a run, not finished",
+              "mean of the runs at one (ΔLk, Cs)"]
     axes.flat[0].legend(handles, texts, fontsize="small")
     if grids_title(grid):
         fig.suptitle(grids_title(grid))
@@ -265,12 +265,12 @@ def timeseries_panels(grid, dlks, css, out):
                 if loc:
                     ax_t.plot([0.5 * (w["t_start_us"] + w["t_end_us"]) for w in loc],
                               [w["tau_us"] for w in loc], "o", linestyle=ls, color=c, markersize=3)
-                    marks["• τ(t) on a window"] = Line2D([], [], color="k", marker="o",
+                    marks["τ(t) on a window"] = Line2D([], [], color="k", marker="o",
                                                          markersize=3, linestyle="none")
                 settled = run.summary.get("contacts_settled_time_us")
                 if settled is not None:
                     ax_k.axvline(settled, color=c, linestyle=":", linewidth=1)
-                    marks["dotted: contacts settle"] = Line2D([], [], color="k", linestyle=":",
+                    marks["contacts settle"] = Line2D([], [], color="k", linestyle=":",
                                                               linewidth=1)
         ax_e.set_title(f"ΔLk = {dlk}")
         if ax_k.get_lines():

@@ -94,7 +94,7 @@ def test_plot_legend_titles_and_log_ticks(tmp_path):
     # one entry per run (the two at ΔLk 2 named), one per kind of mark
     assert sum("ΔLk = 2" in t for t in texts) == 2 and sum("ΔLk = 4" in t for t in texts) == 1
     assert any("(a)" in t for t in texts) and any("(b)" in t for t in texts)
-    assert "○ transient state" in texts and "dotted: writhe convergence time" in texts
+    assert "transient state" in texts and "writhe convergence time" in texts
     assert len(texts) == 5
     assert len(ax_k.get_legend().get_texts()) == 3  # a fitted τ line per run
     # what all runs share (Cs, grid) is in the title
@@ -146,7 +146,7 @@ def test_report_means_and_tiles(tmp_path):
     markers = [l for l in ax_bend.get_lines() if l.get_marker() == "o" and l.get_xdata().size]
     assert len(markers) == 4  # one per run
     texts = [t.get_text() for t in ax_bend.get_legend().get_texts()]
-    assert {"Cs = 0.05 M", "Cs = 0.1 M", "○ a run, not finished"} <= set(texts)
+    assert {"Cs = 0.05 M", "Cs = 0.1 M", "a run, not finished"} <= set(texts)
 
     ts_axes = ibrod_report.timeseries_panels(grid, dlks, css, str(tmp_path / "ts.pdf"))
     assert (tmp_path / "ts.pdf").read_bytes().startswith(b"%PDF")
