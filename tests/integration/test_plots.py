@@ -24,6 +24,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.image as mpimg  # noqa: E402
+import numpy as np  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 PLOT = os.path.join(ROOT, "python", "ibrod_plot.py")
@@ -126,11 +127,11 @@ class PlotsAndReport(unittest.TestCase):
         # --colour twist: the final state coloured by twist density, its range printed. The mean
         # twist density is 360° Tw / L with Tw = ΔLk − Wr (the rod is intrinsically untwisted):
         # it lies in the printed range
-        r = sh(BINARY, "render", self.a, "--views", "bottom", "--size", "64x64", "--colour", "twist")
+        r = sh(BINARY, "render", self.a, "--views", "bottom", "--size", "64x64",
+               "--colour", "twist")
         m = re.search(r"twist colour from (\S+) \(blue\) to (\S+) \(red\) deg/nm", r.stdout)
         self.assertIsNotNone(m, r.stdout)
         lo, hi = float(m.group(1)), float(m.group(2))
-        import numpy as np
         fs = np.genfromtxt(os.path.join(self.a, "final_state.csv"), delimiter=",", names=True)
         p = np.column_stack([fs["x_A"], fs["y_A"], fs["z_A"]])
         length_nm = np.linalg.norm(np.roll(p, -1, axis=0) - p, axis=1).sum() / 10
