@@ -152,8 +152,9 @@ void add_analysis_commands(CLI::App& app) {
   render
       ->add_option("--colour", r->opt.colour,
                    "body colour: stripe (blue, with an orange stripe along D1), along (a colour "
-                   "map from the first point to the last) or height (a colour map of z)")
-      ->check(CLI::IsMember({"stripe", "along", "height"}))
+                   "map from the first point to the last), height (a colour map of z) or twist "
+                   "(a colour map of the twist density, lowest to highest)")
+      ->check(CLI::IsMember({"stripe", "along", "height", "twist"}))
       ->capture_default_str();
   render->add_flag("!--no-labels", r->opt.labels,
                    "no time, Wr, ΔLk, Cs and scale bar on the pictures");

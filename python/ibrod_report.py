@@ -1,9 +1,9 @@
 #!/usr/bin/python3
-"""The report of a sweep of ibrod runs (MODEL §7), one markdown page with PNG figures in the
-layout of a paper.
+"""The report of a sweep of ibrod runs (MODEL §7), one markdown page with figures (PNG, or
+vector PDF/SVG with --format) in the layout of a paper.
 
     python/ibrod_report.py RUN_DIR... -o REPORT_DIR [--view oblique] [--ibrod BINARY] [--frames]
-                           [--tau-window US]
+                           [--tau-window US] [--format png|pdf|svg]
 
 Writes into REPORT_DIR:
   report.md           the runs; tables with rows ΔLk and columns Cs of the writhe convergence
@@ -11,14 +11,17 @@ Writes into REPORT_DIR:
                       approach) and the transient states; the figures below
   runs.csv            one row per run: ΔLk, Cs, stop reason, final observables, the analysis
   vs_excess_link.png  E_bend, E_twist, ΔE_electro, Wr and closest approach of the final state
-                      against ΔLk, one line per Cs
+                      against ΔLk, one line per Cs; a marker per run, the line through the mean
+                      of the runs at the same (ΔLk, Cs)
   timeseries.png      E_total, E_K (log), Wr and τ(t) against time: one column per ΔLk, one line
-                      per Cs
-  shapes.png          contact sheet: every run's final shape (rows ΔLk, columns Cs), its time,
-                      class and stop reason on the tile
+                      per run (two runs at the same (ΔLk, Cs): two line styles, named)
+  shapes.png          contact sheet: one tile per run (rows ΔLk, columns Cs, a cell with several
+                      runs side by side), its name, ΔLk, Cs, time, class and stop reason on the tile
   sampling_N.png      for each group of runs that differ only in their perturbation (a sweep
                       over rod.perturbation_random.seed at one ΔLk, Cs): one picture per final
                       shape class, with its count and energy (report.md: "Perturbation sampling")
+(.pdf or .svg instead of .png with --format; the contact sheet stays PNG, as it holds pictures).
+Titles carry the grid (n³, box) of the runs.
 
 report.md also says, for each (ΔLk, Cs), whether the twisted circle was stable as the stability
 test decided (summary.json stability_tests), and brackets the threshold ΔLk per Cs. The grouping
@@ -47,9 +50,10 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from ibrod_plot import Run  # noqa: E402
+from ibrod_plot import FORMATS, Run, log_axis, save  # noqa: E402
 from ibrod_study import (CIRCLE_WRITHE, circle_stability, class_census,  # noqa: E402
                          perturbation_label, sampling_groups, stability_bracket)
+from matplotlib.lines import Line2D  # noqa: E402
 
 DASH = "—"
 NOT_ANALYSED = "not analysed"
@@ -140,23 +144,63 @@ def put_caption(ax, text):
     put(0.5, -0.02, text, ha="center", va="top", fontsize="small", transform=ax.transAxes)
 
 
-def contact_sheet(grid, dlks, css, view, out):
-    nr, nc = len(dlks), len(css)
-    fig = plt.figure(figsize=(3.0 * nc + 0.6, 3.4 * nr + 0.4))
+def sheet_layout(grid, dlks, css):
+    """Tile positions of the contact sheet: {run: (row, column)}, rows ΔLk, columns Cs with as
+    many sub-columns as the fullest cell at that Cs (every run gets its own tile), and the
+    number of columns and the first column of each Cs."""
+    width = {cs: max(len(grid.get((d, cs), [])) for d in dlks) or 1 for cs in css}
+    first, col = {}, 0
+    for cs in css:
+        first[cs], col = col, col + width[cs]
+    where = {}
     for i, dlk in enumerate(dlks):
-        for j, cs in enumerate(css):
-            runs = grid.get((dlk, cs), [])
-            idx = i * nc + j + 1
-            ax = draw_tile(fig, nr, nc, idx, runs[0] if runs else None, view)
-            title = f"ΔLk = {dlk}, Cs = {cs:g} M"
-            if len(runs) > 1:
-                title += f" (+{len(runs) - 1})"
-            ax.set_title(title, fontsize="small")
-            if runs:
-                put_caption(ax, tile_caption(runs[0]))
+        for cs in css:
+            for k, run in enumerate(sorted(grid.get((dlk, cs), []), key=lambda r: r.name)):
+                where[run] = (i, first[cs] + k)
+    return where, col, first, width
+
+
+def contact_sheet(grid, dlks, css, view, out, tile_in=3.6, dpi=100):
+    """One tile of tile_in × tile_in inches per run (at dpi: 360 px by default), titled with its
+    run name, ΔLk and Cs, captioned with its time, class and stop reason; an empty cell holds a
+    dash. Returns the tiles as a list of (run, axes)."""
+    where, ncol, first, width = sheet_layout(grid, dlks, css)
+    nr = len(dlks)
+    fig = plt.figure(figsize=(tile_in * ncol, (tile_in + 0.7) * nr))
+    gs = fig.add_gridspec(nr, ncol)
+    tiles = []
+    for run, (i, j) in sorted(where.items(), key=lambda kv: kv[1]):
+        pic = final_picture(run, view)
+        if pic is None:
+            ax = fig.add_subplot(gs[i, j], projection="3d")
+            draw_final_state_3d(ax, run)
+        else:
+            ax = fig.add_subplot(gs[i, j])
+            ax.set_xticks([])
+            ax.set_yticks([])
+            for sp in ax.spines.values():
+                sp.set_visible(False)
+            ax.imshow(mpimg.imread(pic))
+        ax.set_title(f"{run.name}\nΔLk = {run.excess_link}, Cs = {run.salt_M:g} M",
+                     fontsize="medium")
+        put = ax.text2D if hasattr(ax, "text2D") else ax.text  # text2D on a 3-D axes
+        put(0.5, -0.02, tile_caption(run), ha="center", va="top", fontsize="medium",
+            transform=ax.transAxes)
+        tiles.append((run, ax))
+    for i, dlk in enumerate(dlks):  # empty cells
+        for cs in css:
+            if not grid.get((dlk, cs)):
+                ax = fig.add_subplot(gs[i, first[cs]])
+                ax.set_axis_off()
+                ax.text(0.5, 0.5, f"ΔLk = {dlk}, Cs = {cs:g} M\n{DASH}", ha="center",
+                        va="center", transform=ax.transAxes, fontsize="medium")
+    grids = sorted({r.grid for r in where if r.grid})
+    if grids:
+        fig.suptitle("; ".join(grids))
     fig.tight_layout()
-    fig.savefig(out, dpi=80)
+    fig.savefig(out, dpi=dpi)
     plt.close(fig)
+    return tiles
 
 
 def relaxed_circle_electro(grid, cs):
@@ -168,8 +212,15 @@ def relaxed_circle_electro(grid, cs):
     return None
 
 
+def grids_title(grid):
+    """The grids of the runs ("16³ grid, box 200 Å"), for a figure title."""
+    return "; ".join(sorted({r.grid for runs in grid.values() for r in runs if r.grid}))
+
+
 def against_excess_link(grid, dlks, css, out):
-    """Final-state quantities against ΔLk; hollow markers: runs that did not finish."""
+    """Final-state quantities against ΔLk: a marker per run (hollow: did not finish), the line of
+    each Cs through the mean of the runs at the same (ΔLk, Cs), so that two runs at one point
+    never draw a vertical line. Returns the figure's axes (before closing)."""
     panels = [
         ("E_bend (kT)", lambda r, cs: final(r, "E_bend_kT")),
         ("E_twist (kT)", lambda r, cs: final(r, "E_twist_kT")),
@@ -185,18 +236,21 @@ def against_excess_link(grid, dlks, css, out):
     for ax, (ylabel, value) in zip(axes.flat, panels):
         for k, cs in enumerate(css):
             c = colors[k % len(colors)]
-            xs, ys, done = [], [], []
+            xs, means, points = [], [], []
             for dlk in dlks:
+                vs = []
                 for run in grid.get((dlk, cs), []):
                     v = value(run, cs)
                     if v is not None and np.isfinite(v):
-                        xs.append(dlk)
-                        ys.append(v)
-                        done.append(run.finished is True)
+                        vs.append(v)
+                        points.append((dlk, v, run.finished is True))
+                if vs:
+                    xs.append(dlk)
+                    means.append(float(np.mean(vs)))
             if not xs:
                 continue
-            ax.plot(xs, ys, "-", color=c, label=f"Cs = {cs:g} M")
-            for x, y, d in zip(xs, ys, done):
+            ax.plot(xs, means, "-", color=c, label=f"Cs = {cs:g} M")
+            for x, y, d in points:
                 ax.plot([x], [y], "o", color=c, mfc=c if d else "none")
         if not any(ax.get_lines()):
             ax.text(0.5, 0.5, "no run that stays circular\nand reached equilibrium",
@@ -205,9 +259,18 @@ def against_excess_link(grid, dlks, css, out):
         ax.set_ylabel(ylabel)
         ax.set_xticks(dlks)
         ax.grid(True, alpha=0.3)
-    axes.flat[0].legend(fontsize="small", title="hollow: not finished", title_fontsize="x-small")
-    fig.savefig(out, dpi=80)
+    handles, texts = axes.flat[0].get_legend_handles_labels()
+    handles += [Line2D([], [], color="k", marker="o", linestyle="none"),
+                Line2D([], [], color="k", marker="o", mfc="none", linestyle="none"),
+                Line2D([], [], color="k")]
+    texts += ["a run, finished", "a run, not finished",
+              "mean of the runs at one (ΔLk, Cs)"]
+    axes.flat[0].legend(handles, texts, fontsize="small")
+    if grids_title(grid):
+        fig.suptitle(grids_title(grid))
+    save(fig, out, dpi=100)
     plt.close(fig)
+    return axes
 
 
 def timeseries_panels(grid, dlks, css, out):
@@ -216,36 +279,49 @@ def timeseries_panels(grid, dlks, css, out):
     fig, axes = plt.subplots(4, nc, figsize=(3.6 * nc + 0.6, 9), sharex="col", squeeze=False,
                              constrained_layout=True)
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    styles = ["-", "--", "-.", (0, (1, 1))]
     for j, dlk in enumerate(dlks):
         ax_e, ax_k, ax_w, ax_t = axes[:, j]
+        marks = {}
         for k, cs in enumerate(css):
-            for run in grid.get((dlk, cs), []):
-                c = colors[k % len(colors)]
+            runs = sorted(grid.get((dlk, cs), []), key=lambda r: r.name)
+            for n, run in enumerate(runs):  # two runs at one (ΔLk, Cs): two styles, named
+                c, ls = colors[k % len(colors)], styles[n % len(styles)]
                 t = run.ts["time_us"]
-                lab = f"Cs = {cs:g} M" + ("" if run.finished is not False else f" ({NOT_FINISHED})")
-                ax_e.plot(t, run.ts["E_total_kT"], color=c, label=lab)
+                lab = f"Cs = {cs:g} M" + (f" ({run.name})" if len(runs) > 1 else "")
+                lab += "" if run.finished is not False else f" ({NOT_FINISHED})"
+                ax_e.plot(t, run.ts["E_total_kT"], color=c, linestyle=ls, label=lab)
                 ek = run.ts["E_kinetic_kT"]
-                ax_k.plot(t[ek > 0], ek[ek > 0], color=c)
-                ax_w.plot(t, run.ts["writhe"], color=c)
+                ax_k.plot(t[ek > 0], ek[ek > 0], color=c, linestyle=ls)
+                ax_w.plot(t, run.ts["writhe"], color=c, linestyle=ls)
                 loc = [w for w in run.summary.get("relaxation_time_local_us") or [] if w["tau_us"] > 0]
                 if loc:
                     ax_t.plot([0.5 * (w["t_start_us"] + w["t_end_us"]) for w in loc],
-                              [w["tau_us"] for w in loc], "o-", color=c, markersize=3)
+                              [w["tau_us"] for w in loc], "o", linestyle=ls, color=c, markersize=3)
+                    marks["τ(t) on a window"] = Line2D([], [], color="k", marker="o",
+                                                         markersize=3, linestyle="none")
                 settled = run.summary.get("contacts_settled_time_us")
                 if settled is not None:
                     ax_k.axvline(settled, color=c, linestyle=":", linewidth=1)
+                    marks["contacts settle"] = Line2D([], [], color="k", linestyle=":",
+                                                              linewidth=1)
         ax_e.set_title(f"ΔLk = {dlk}")
-        ax_k.set_yscale("log")
+        if ax_k.get_lines():
+            log_axis(ax_k, "y")
         ax_t.set_xlabel("time (µs)")
-        ax_e.legend(fontsize="x-small")
+        handles, texts = ax_e.get_legend_handles_labels()
+        ax_e.legend(handles + list(marks.values()), texts + list(marks.keys()), fontsize="x-small")
         for ax in axes[:, j]:
             ax.grid(True, alpha=0.3)
     axes[0, 0].set_ylabel("E_total (kT)")
     axes[1, 0].set_ylabel("E_K (kT); dotted: contacts settle")
     axes[2, 0].set_ylabel("writhe")
     axes[3, 0].set_ylabel("τ(t) (µs)")
-    fig.savefig(out, dpi=80)
+    if grids_title(grid):
+        fig.suptitle(grids_title(grid))
+    save(fig, out, dpi=100)
     plt.close(fig)
+    return axes
 
 
 def table(grid, dlks, css, cell):
@@ -453,6 +529,9 @@ def main(argv=None):
                    help="with --ibrod: `analyze --frames` (the shape of every frame names transients)")
     p.add_argument("--tau-window", metavar="US",
                    help="with --ibrod: `analyze --tau-window US` (windows of τ(t), µs; default 1)")
+    p.add_argument("--format", choices=FORMATS, default="png",
+                   help="format of the plots (vs_excess_link, timeseries): png, or vector pdf/svg; "
+                        "the contact sheet is always PNG")
     a = p.parse_args(argv)
 
     if a.ibrod:
@@ -460,7 +539,7 @@ def main(argv=None):
             maybe_run(a.ibrod, ["analyze", "--quiet", d] + (["--frames"] if a.frames else []) +
                       (["--tau-window", a.tau_window] if a.tau_window else []))
             if not glob.glob(os.path.join(d, "render", f"rod_{a.view}_t*.png")):
-                maybe_run(a.ibrod, ["render", d, "--views", a.view, "--size", "300x300"])
+                maybe_run(a.ibrod, ["render", d, "--views", a.view, "--size", "360x360"])
 
     runs = [Run(d) for d in a.runs]
     os.makedirs(a.output, exist_ok=True)
@@ -476,21 +555,26 @@ def main(argv=None):
 
     figures = []
     if grid:
-        against_excess_link(grid, dlks, css, os.path.join(a.output, "vs_excess_link.png"))
-        timeseries_panels(grid, dlks, css, os.path.join(a.output, "timeseries.png"))
-        contact_sheet(grid, dlks, css, a.view, os.path.join(a.output, "shapes.png"))
+        vs, tsname = f"vs_excess_link.{a.format}", f"timeseries.{a.format}"
+        against_excess_link(grid, dlks, css, os.path.join(a.output, vs))
+        timeseries_panels(grid, dlks, css, os.path.join(a.output, tsname))
+        tiles = contact_sheet(grid, dlks, css, a.view, os.path.join(a.output, "shapes.png"))
         figures = [
-            ("Final state against ΔLk", "vs_excess_link.png",
+            ("Final state against ΔLk", vs,
              "E_bend, E_twist, the electrostatic energy relative to the initial circle at the same "
              "Cs (`dE_electro_kT`) and relative to the relaxed circle at the same Cs (the final "
              "state of a run of the sweep at that Cs that stays circular and reached equilibrium; "
-             "empty when there is none), writhe and closest approach. Hollow markers: runs that "
-             "did not reach equilibrium (their last state, not a limit)."),
-            ("Energy, kinetic energy, writhe and τ(t) against time", "timeseries.png",
-             "One column per ΔLk, one line per Cs. τ(t) = −2/(d ln E_K/dt) on windows of "
+             "empty when there is none), writhe and closest approach. A marker per run; hollow: "
+             "runs that did not reach equilibrium (their last state, not a limit). The line of "
+             "each Cs joins the means of the runs at the same (ΔLk, Cs)."),
+            ("Energy, kinetic energy, writhe and τ(t) against time", tsname,
+             "One column per ΔLk, one line per run (runs at the same Cs: one colour, line styles "
+             "and names tell them apart). τ(t) = −2/(d ln E_K/dt) on windows of "
              "`relaxation_time_local_window_us`; dotted: the contacts stop changing."),
             ("Contact sheet", "shapes.png",
-             "Every run (rows ΔLk, columns Cs): time of the state, shape class and stop reason."),
+             f"{len(tiles)} tiles, one per run (rows ΔLk, columns Cs; several runs at one "
+             "(ΔLk, Cs) side by side): run name, ΔLk, Cs, time of the state, shape class and "
+             "stop reason."),
         ]
     write_runs_csv(runs, os.path.join(a.output, "runs.csv"))
 

@@ -19,6 +19,7 @@ packages=(
   python3-dev pybind11-dev python3-pytest   # the Python module ibrod (docs/python.md) and its tests
   python3-mdanalysis    # tests: MDAnalysis reads trajectory.h5 (H5MD)
   python3-vtk9          # tests: VTK's own readers open the .vtp/.vti files
+  ffmpeg                # render --movie encodes the frames as MP4 (and ffprobe for its test)
 )
 
 missing=()

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <numbers>
 #include <sstream>
 
 #include "core/error.hpp"
@@ -277,8 +278,10 @@ std::vector<fs::path> render_run(const fs::path& dir, const RenderOptions& opt, 
     style.colouring = render::Colouring::along;
   else if (opt.colour == "height")
     style.colouring = render::Colouring::height;
+  else if (opt.colour == "twist")
+    style.colouring = render::Colouring::twist;
   else if (opt.colour != "stripe")
-    throw ConfigError("--colour '" + opt.colour + "': expected stripe, along or height");
+    throw ConfigError("--colour '" + opt.colour + "': expected stripe, along, height or twist");
   // labels need about 50 px of height and 130 of width (font 5×7 px): smaller pictures go without
   const bool labels = opt.labels && opt.height >= 120 && opt.width >= 160;
   if (opt.labels && !labels && log)
@@ -308,6 +311,13 @@ std::vector<fs::path> render_run(const fs::path& dir, const RenderOptions& opt, 
       throw RunError(std::string("render: ") + e.what());
     }
     if (log && !opt.movie) std::fprintf(log, "%s\n", file.c_str());
+    if (log && !opt.movie && style.colouring == render::Colouring::twist) {
+      const auto tw = render::twist_density(f.X, f.d1);  // rad/Å, per segment
+      const auto [lo, hi] = std::minmax_element(tw.begin(), tw.end());
+      constexpr double deg_per_nm = 10 * 180 / std::numbers::pi;
+      std::fprintf(log, "render: twist colour from %.3g (blue) to %.3g (red) deg/nm\n",
+                   *lo * deg_per_nm, *hi * deg_per_nm);
+    }
     written.push_back(file);
   }
   if (opt.movie) {

@@ -45,6 +45,7 @@ struct RenderOptions {
   bool movie = false;  ///< every frame of the trajectory, one view (movie_<view>/, + MP4)
   bool labels = true;  ///< time, Wr, ΔLk and Cs at the top left and a scale bar in Å
   std::string colour = "stripe";  ///< "stripe" | "along" (index along the rod) | "height" (z)
+                                  ///< | "twist" (twist density, render::twist_density)
 };
 
 /// Parses "WxH" (e.g. "800x600") into width and height; ConfigError if malformed or not in

@@ -58,6 +58,32 @@ Rgb colour_map(double t) {
 
 }  // namespace
 
+std::vector<double> twist_density(std::span<const Vec3> X, std::span<const Vec3> d1) {
+  const std::size_t n = X.size();
+  if (n < 2 || d1.size() != n)
+    throw std::invalid_argument("twist_density: needs at least 2 points and one director each");
+  // vertex tangents (central differences) and D¹ made ⟂ to them
+  std::vector<Vec3> t(n), d(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const Vec3 c = X[(k + 1) % n] - X[(k + n - 1) % n];
+    t[k] = c.norm() > 0 ? Vec3(c.normalized()) : Vec3(0, 0, 1);
+    d[k] = d1[k] - d1[k].dot(t[k]) * t[k];
+  }
+  std::vector<double> tw(n, 0.0);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t m = (k + 1) % n;
+    const double len = (X[m] - X[k]).norm();
+    const double c = t[k].dot(t[m]);
+    if (!(len > 0) || !(c > -0.99)) continue;
+    // D¹_k parallel-transported to t_{k+1} (the smallest rotation taking t_k to t_{k+1}), then
+    // the signed angle to D¹_{k+1} about t_{k+1}
+    const Vec3 w = t[k].cross(t[m]);
+    const Vec3 p = c * d[k] + w.cross(d[k]) + w * (w.dot(d[k]) / (1 + c));
+    tw[k] = std::atan2(p.cross(d[m]).dot(t[m]), p.dot(d[m])) / len;
+  }
+  return tw;
+}
+
 std::vector<std::string> standard_view_names() {
   return {"top", "bottom", "side", "front", "oblique"};
 }
@@ -135,7 +161,24 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
   std::vector<float> shade(depth.size(), 0.0f);
   std::vector<std::uint8_t> on_stripe(depth.size(), 0);
   std::vector<float> param(style.colouring == Colouring::stripe ? 0 : depth.size(), 0.0f);
+  // arc length of the nearest hit's axis point from X_0, for the outlines
+  std::vector<float> arc(depth.size(), 0.0f);
+  std::vector<double> cum(n + 1, 0.0);
+  for (std::size_t k = 0; k < n; ++k) cum[k + 1] = cum[k] + (X[(k + 1) % n] - X[k]).norm();
+  const double arc_total = cum[n];
   double z_lo = std::numeric_limits<double>::infinity(), z_hi = -z_lo;
+  // twist colouring: the twist density at each point (mean of its two segments), mapped from
+  // the frame's lowest (0) to its highest (1); uniform twist: the middle of the map
+  std::vector<double> tw_point;
+  if (style.colouring == Colouring::twist) {
+    const auto tw = twist_density(X, d1);
+    tw_point.resize(n);
+    for (std::size_t k = 0; k < n; ++k) tw_point[k] = 0.5 * (tw[(k + n - 1) % n] + tw[k]);
+    const auto [lo, hi] = std::minmax_element(tw_point.begin(), tw_point.end());
+    const double t_lo = *lo, t_hi = *hi, t_span = t_hi - t_lo;
+    const bool uniform = !(t_span > 1e-6 * std::max(std::abs(t_lo), std::abs(t_hi)));
+    for (auto& t : tw_point) t = uniform ? 0.5 : (t - t_lo) / t_span;
+  }
   for (const auto& x : X) z_lo = std::min(z_lo, x.z()), z_hi = std::max(z_hi, x.z());
 
   // vertex tangents (central differences), blended along each segment for smooth shading
@@ -183,16 +226,27 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
         // shade with the same ⟂ normal (Phong-like smoothing across the joints)
         const Vec3 ns = np.norm() > 1e-12 ? Vec3(np.normalized()) : nrm;
         shade[idx] = float(style.ambient + (1 - style.ambient) * std::max(0.0, ns.dot(light)));
+        arc[idx] = float(cum[k] + hit.h * len);
         if (style.colouring == Colouring::along)
           param[idx] = float((double(k) + hit.h) / double(n));
         else if (style.colouring == Colouring::height)
           param[idx] = z_hi > z_lo ? float((axis.z() - z_lo) / (z_hi - z_lo)) : 0.5f;
+        else if (style.colouring == Colouring::twist)
+          param[idx] = float((1 - hit.h) * tw_point[k] + hit.h * tw_point[(k + 1) % n]);
       }
     }
   }
 
   // outlines: darken the nearer side of every occlusion boundary (a neighbour within about one
-  // pixel is background or lies behind by more than the radius), so crossings read as such
+  // pixel is background, or lies behind by more than the radius on a part of the rod more than
+  // style.outline_arc diameters away along it), so crossings read as such; where the tube turns
+  // toward the viewer in front of its own continuation there is no line across it, which would
+  // look like the cap of a free end
+  const double arc_gap = style.outline_arc * diameter;
+  const auto far_along = [&](float s1, float s2) {
+    const double ds = std::abs(double(s1) - double(s2));
+    return std::min(ds, arc_total - ds) > arc_gap;
+  };
   if (style.outline_darken < 1) {
     const int reach = S;
     std::vector<std::uint8_t> edge(depth.size(), 0);
@@ -204,7 +258,9 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
           const int nx[4] = {px - d, px + d, px, px}, ny[4] = {py, py, py - d, py + d};
           for (int q = 0; q < 4; ++q) {
             if (nx[q] < 0 || ny[q] < 0 || nx[q] >= W || ny[q] >= H) continue;
-            if (depth[std::size_t(ny[q]) * std::size_t(W) + std::size_t(nx[q])] > depth[idx] + R)
+            const std::size_t nq = std::size_t(ny[q]) * std::size_t(W) + std::size_t(nx[q]);
+            if (!std::isfinite(depth[nq]) ||
+                (depth[nq] > depth[idx] + R && far_along(arc[nq], arc[idx])))
               edge[idx] = 1;
           }
         }

@@ -3,7 +3,9 @@
 // on the side the director D¹ points to, so that twist shows as a helical stripe. Software
 // ray casting of one capsule (cylinder + spherical caps) per segment X_k → X_{k+1} (X_n = X_0)
 // under an orthographic camera, nearest hit per pixel (a z-buffer), Lambert + ambient shading,
-// dark outlines where one part of the tube passes in front of another, S×S supersampling. Knows
+// dark outlines on the silhouette and where one part of the tube passes in front of a distant
+// part (not where it turns toward the viewer in front of its own continuation), S×S
+// supersampling. Knows
 // points and directors only.
 #include <span>
 #include <string>
@@ -30,9 +32,17 @@ View standard_view(const std::string& name);
 std::vector<std::string> standard_view_names();
 
 /// What colours the tube's body: one colour with the D¹ stripe in a second; or a colour map
-/// along the rod (point index: start blue → end red) or of the lab height z, with the stripe a
-/// darker shade of the body.
-enum class Colouring { stripe, along, height };
+/// along the rod (point index: start blue → end red), of the lab height z, or of the twist
+/// density (twist_density, the picture's lowest blue → highest red; uniform: green), with the
+/// stripe a darker shade of the body.
+enum class Colouring { stripe, along, height, twist };
+
+/// The twist density of each segment X_k → X_{k+1} (X_n = X_0), in radians per unit of X's
+/// length: D¹_k (made ⟂ to the vertex tangent t_k, central differences) parallel-transported to
+/// t_{k+1} by the smallest rotation, then its signed angle (right-handed about t_{k+1}) to
+/// D¹_{k+1}, over the segment's length (0 where the tangent turns by more than ~172°). X.size() ≥ 2
+/// and d1.size() = X.size(), else std::invalid_argument.
+std::vector<double> twist_density(std::span<const Vec3> X, std::span<const Vec3> d1);
 
 struct Style {
   Colouring colouring = Colouring::stripe;
@@ -44,8 +54,11 @@ struct Style {
   double ambient = 0.3;      ///< shade = ambient + (1 − ambient) max(0, n · light)
   double outline_darken = 0.45;  ///< shade factor of a ≈ 1 pixel outline on the near side of
                                  ///< occlusion boundaries (1: no outlines)
-  int supersample = 3;           ///< S×S rays per pixel, averaged
-  double margin = 0.04;          ///< free border on each side, fraction of the smaller image side
+  double outline_arc = 2;  ///< an occluded neighbour gets an outline only when it is more than this
+                           ///< many diameters away along the rod (a part that turns toward the
+                           ///< viewer in front of its own continuation has none)
+  int supersample = 3;     ///< S×S rays per pixel, averaged
+  double margin = 0.04;    ///< free border on each side, fraction of the smaller image side
   double depth_cue = 0.35;  ///< the farthest tube surface is blended this far toward the background
   std::vector<std::string> labels;  ///< lines written at the top left (a band the rod stays out of)
   bool scale_bar = false;           ///< a bar of a round length at the bottom left, labelled in Å

@@ -27,6 +27,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.image as mpimg  # noqa: E402
+import numpy as np  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 PLOT = os.path.join(ROOT, "python", "ibrod_plot.py")
@@ -126,6 +127,20 @@ class PlotsAndReport(unittest.TestCase):
         self.png(os.path.join(self.a, "render", "rod_side_t0.0300.png"))
         r = sh(BINARY, "render", self.a, "--time", "0.01", "--views", "front", "--size", "32x32")
         self.assertNotIn("warning", r.stdout)
+        # --colour twist: the final state coloured by twist density, its range printed. The mean
+        # twist density is 360° Tw / L with Tw = ΔLk − Wr (the rod is intrinsically untwisted):
+        # it lies in the printed range
+        r = sh(BINARY, "render", self.a, "--views", "bottom", "--size", "64x64",
+               "--colour", "twist")
+        m = re.search(r"twist colour from (\S+) \(blue\) to (\S+) \(red\) deg/nm", r.stdout)
+        self.assertIsNotNone(m, r.stdout)
+        lo, hi = float(m.group(1)), float(m.group(2))
+        fs = np.genfromtxt(os.path.join(self.a, "final_state.csv"), delimiter=",", names=True)
+        p = np.column_stack([fs["x_A"], fs["y_A"], fs["z_A"]])
+        length_nm = np.linalg.norm(np.roll(p, -1, axis=0) - p, axis=1).sum() / 10
+        ts = np.genfromtxt(os.path.join(self.a, "timeseries.csv"), delimiter=",", names=True)
+        mean = 360 * (2 - ts["writhe"][-1]) / length_nm
+        self.assertTrue(0 < lo < mean < hi, (lo, mean, hi))
 
     def test_1b_movie(self):
         # every frame of trajectory.h5 (16: steps 0, 20, …, 300) from the first view, one scale;
@@ -139,6 +154,12 @@ class PlotsAndReport(unittest.TestCase):
         mp4 = os.path.join(self.b, "render", "rod_oblique.mp4")
         if shutil.which("ffmpeg"):
             self.assertTrue(os.path.getsize(mp4) > 0)
+            # the MP4 holds every frame: ffprobe counts the decoded frames of its video stream
+            if shutil.which("ffprobe"):
+                n = sh("ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0",
+                       "-show_entries", "stream=nb_read_frames,width,height", "-of", "csv=p=0",
+                       mp4).stdout.strip()
+                self.assertEqual(n, "48,40,16", n)  # width, height, frames
         else:
             self.assertIn("ffmpeg not found", r.stdout)
             self.assertFalse(os.path.exists(mp4))

@@ -335,6 +335,101 @@ TEST(Render, DepthCueLightensTheFarSideAndColourMapsFollowTheRod) {
   EXPECT_GT(mid.g, mid.b);
 }
 
+TEST(Render, ATubeTurningTowardTheViewerHasNoOutlineAcrossItLikeAFreeEnd) {
+  // a 200 × 60 Å rectangle standing in the x–z plane (points 5 Å apart), seen from above with a
+  // 15° tilt: its upper (near) edge hides most of the lower one, and at the corners the tube
+  // turns away from the viewer behind its own near end. Inside the rod's silhouette the outline
+  // may only mark the near edge passing over the far one (one horizontal line); a line across
+  // the tube at a corner, where the near edge meets its own continuation, would draw the cap of
+  // a free end.
+  std::vector<Vec3> X, d1;
+  const auto edge = [&](Vec3 a, Vec3 b) {
+    const int m = int(std::lround((b - a).norm() / 5));
+    for (int i = 0; i < m; ++i)
+      X.push_back(a + (b - a) * (double(i) / m)), d1.emplace_back(0, 1, 0);
+  };
+  edge({-100, 0, 0}, {100, 0, 0});
+  edge({100, 0, 0}, {100, 0, 60});
+  edge({100, 0, 60}, {-100, 0, 60});
+  edge({-100, 0, 60}, {-100, 0, 0});
+  const double tilt = 15 * kPi / 180;
+  const View view{"tilted", Vec3(0, std::sin(tilt), -std::cos(tilt)), Vec3(0, 1, 0)};
+  Style plain, outlined;
+  plain.outline_darken = 1;
+  const int w = 400, h = 200;
+  const Image a = render_rod(X, d1, 20.0, view, w, h, plain);
+  const Image b = render_rod(X, d1, 20.0, view, w, h, outlined);
+  const auto near_background = [&](int x, int y) {
+    for (int j = -2; j <= 2; ++j)
+      for (int i = -2; i <= 2; ++i)
+        if (x + i >= 0 && y + j >= 0 && x + i < w && y + j < h && is_background(a.at(x + i, y + j)))
+          return true;
+    return false;
+  };
+  int silhouette = 0, inside = 0, y_lo = h, y_hi = -1;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      if (!(a.at(x, y) == b.at(x, y))) {
+        if (near_background(x, y)) {
+          ++silhouette;
+        } else {
+          ++inside;
+          y_lo = std::min(y_lo, y), y_hi = std::max(y_hi, y);
+        }
+      }
+  EXPECT_GT(silhouette, 500);  // the silhouette is outlined
+  EXPECT_GT(inside, 200);      // so is the near edge over the far one, across the picture
+  EXPECT_LE(y_hi - y_lo, 1);   // and nothing else: no line across the tube at the corners
+}
+
+TEST(Render, TwistDensityOfATwistedRingAndTheTwistColouring) {
+  // D¹ turns φ(s) = 3 s + 1.5 sin s about the tangent of a circle (s the angle, r0 = 100 Å):
+  // twist density φ'(s)/r0 = (3 + 1.5 cos s)/r0, highest at s = 0 (+x), lowest at s = π (−x)
+  const int n = 400;
+  const double r0 = 100;
+  std::vector<Vec3> X, d1;
+  for (int k = 0; k < n; ++k) {
+    const double s = 2 * kPi * k / n, phi = 3 * s + 1.5 * std::sin(s);
+    const Vec3 radial(std::cos(s), std::sin(s), 0), z(0, 0, 1);
+    X.push_back(r0 * radial);
+    d1.push_back(std::cos(phi) * z + std::sin(phi) * radial);
+  }
+  const auto tw = twist_density(X, d1);
+  ASSERT_EQ(tw.size(), std::size_t(n));
+  double total = 0;
+  for (int k = 0; k < n; ++k) {
+    const double s = 2 * kPi * (k + 0.5) / n;  // the segment's middle
+    // sign: D¹ turns from z toward the outward radial, i.e. right-handed about the tangent
+    // (z × radial = tangent direction)
+    EXPECT_NEAR(tw[k], (3 + 1.5 * std::cos(s)) / r0, 2e-3 / r0) << k;
+    total += tw[k] * (X[(k + 1) % n] - X[k]).norm();
+  }
+  EXPECT_NEAR(total / (2 * kPi), 3.0, 1e-3);  // the twist of the ring, in turns
+  // coloured: red (high twist) at +x, blue (low) at −x, from the top (away from the stripe)
+  Style twist;
+  twist.colouring = Colouring::twist;
+  twist.depth_cue = 0;
+  twist.stripe_cos = 2;  // no stripe: the body colour only
+  const int w = 200, h = 200;
+  const Image img = render_rod(X, d1, 20.0, standard_view("top"), w, h, twist);
+  int x_hi = -1, x_lo = -1;
+  for (int x = w - 1; x >= 0 && x_hi < 0; --x)
+    if (!is_background(img.at(x, h / 2))) x_hi = x - 4;
+  for (int x = 0; x < w && x_lo < 0; ++x)
+    if (!is_background(img.at(x, h / 2))) x_lo = x + 4;
+  const Rgb high = img.at(x_hi, h / 2), low = img.at(x_lo, h / 2);
+  EXPECT_GT(high.r, high.b + 60);
+  EXPECT_GT(low.b, low.r + 60);
+  // a uniformly twisted ring: one colour all around (the middle of the map, green)
+  const Ring uniform(300, 100.0, 4);
+  const Image u = render_rod(uniform.X, uniform.d1, 20.0, standard_view("top"), w, h, twist);
+  for (const int x : {x_hi, x_lo}) {
+    const Rgb p = u.at(x, h / 2);
+    EXPECT_GT(p.g, p.r) << x;
+    EXPECT_GT(p.g, p.b) << x;
+  }
+}
+
 TEST(Render, BadInputThrows) {
   const Ring ring(50, 10.0);
   const std::vector<Vec3> short_d1(ring.d1.begin(), ring.d1.begin() + 10);
