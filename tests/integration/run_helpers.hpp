@@ -36,7 +36,6 @@ inline std::string read_file(const fs::path& p) {
   return ss.str();
 }
 
-/// A running `ibrod` with stdout and stderr going to a log file.
 /// Whether this build runs under AddressSanitizer: it reserves terabytes of shadow memory at
 /// start, so a child under an address-space limit (RLIMIT_AS) cannot start at all; the tests that
 /// impose one skip it there (the Release build runs them).
@@ -46,6 +45,7 @@ inline constexpr bool kAddressSanitizer = true;
 inline constexpr bool kAddressSanitizer = false;
 #endif
 
+/// A running `ibrod` with stdout and stderr going to a log file.
 struct Child {
   pid_t pid = -1;
   fs::path log;
