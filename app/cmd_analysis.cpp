@@ -160,8 +160,9 @@ void add_analysis_commands(CLI::App& app) {
                    "no time, Wr, ΔLk, Cs and scale bar on the pictures");
   render->add_flag("--movie", r->opt.movie,
                    "every frame of DIR/trajectory.h5 from the first view, at one scale, into "
-                   "DIR/render/movie_<view>/frame_NNNNN.png, and DIR/render/rod_<view>.mp4 with "
-                   "ffmpeg if installed");
+                   "DIR/render/movie_<view>/frame_NNNNN.png, as the animated PNG "
+                   "DIR/render/rod_<view>.apng, and DIR/render/rod_<view>.mp4 with ffmpeg if "
+                   "installed");
   render->callback([r] {
     finish([&] {
       ibrod::analysis::parse_size(r->size, r->opt.width, r->opt.height);

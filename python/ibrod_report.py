@@ -442,12 +442,13 @@ def sampling_section(groups, view, outdir):
 def stability_cell(r):
     v = circle_stability(r)
     if v["verdict"] in ("stable", "unstable"):
-        de = v["E_after_kT"] - v["E_before_kT"]
+        de = v["dE_kT"]
         tol = r.config.get("time", {}).get("stability_tolerance_kT")
+        kick = f"{fmt(v['kick_A'])} Å, " if v.get("kick_A") is not None else ""
         text = (f"{v['verdict']} (ΔE {de:+.3g} kT"
                 + (f", tolerance {fmt(tol)} kT" if tol is not None else "")
                 + f"; probe at {fmt(v['time_us'])} µs, seed {v['seed']}, "
-                f"{fmt(v['amplitude_rad'])} rad")
+                f"{kick}{fmt(v['amplitude_rad'])} rad")
         if v["verdict"] == "unstable":
             text += f"; Wr → {fmt(v['writhe_after'], 3)}"
         return text + ")"
@@ -611,8 +612,9 @@ def main(argv=None):
            "## Stability of the twisted circle", "",
            "Whether the circle was stable, as the stability test decided (`time.stability_*`, "
            "summary.json `stability_tests`): the first test, when it found the rod still "
-           f"circular (|Wr| < {CIRCLE_WRITHE}); ΔE is the change of E_total over the probe "
-           "(a fall: unstable). \"left the circle untested\": a run without perturbation whose "
+           f"circular (|Wr| < {CIRCLE_WRITHE}); ΔE is the lowest the kicked copy's E_total "
+           "came relative to the unperturbed continuation's during the probe (below "
+           "−tolerance: unstable). \"left the circle untested\": a run without perturbation whose "
            f"|Wr| grew past {CIRCLE_WRITHE} before E_K fell below `time.stop_kinetic_kT` "
            "(unstable without the test's help); \"undecided\": a perturbed run did so (the "
            "perturbation may have been larger than the circle's basin).", "",

@@ -121,19 +121,26 @@ def circle_stability(run):
 
     Returns a dict: verdict, one of
       "stable"        the first test found the circle (|Wr| < CIRCLE_WRITHE) stable
-      "unstable"      the first test found the circle unstable (the energy fell during the probe)
+      "unstable"      the first test found the circle unstable (the kicked copy's energy ended
+                      below the unperturbed continuation's)
       "left_circle"   a run without perturbation left the circle (|Wr| ≥ CIRCLE_WRITHE) before
                       any test: unstable without the test's help (round-off grew)
       "perturbed_away" a perturbed run left the circle before any test: undecided (the
                       perturbation may have been too large to tell)
       "not_tested"    no test at the circle and the rod stayed circular (the run ended before
                       E_K fell below time.stop_kinetic_kT, or the test is off)
-    and time_us, E_before_kT, E_after_kT, writhe_after, seed, amplitude_rad (of the deciding
-    test, else None), reason (a short text)."""
+    and time_us, E_before_kT, E_reference_kT, E_after_kT, writhe_after, seed, amplitude_rad,
+    kick_A, dE_kT (of the deciding test, else None), reason (a short text). dE_kT is what the
+    test decided on: the lowest the kicked copy's energy came relative to the unperturbed
+    continuation's during the probe (E_difference_min_kT); in a summary.json written before that
+    was recorded, E_after_kT − E_reference_kT, where E_reference_kT is the continuation's energy
+    at the end (E_total_continuation_kT) or, older still, the energy at the test
+    (E_total_before_kT)."""
     tests = run.summary.get("stability_tests") or []
     first = tests[0] if tests else None
-    out = {"verdict": "not_tested", "time_us": None, "E_before_kT": None, "E_after_kT": None,
-           "writhe_after": None, "seed": None, "amplitude_rad": None, "reason": ""}
+    out = {"verdict": "not_tested", "time_us": None, "E_before_kT": None, "E_reference_kT": None,
+           "E_after_kT": None, "writhe_after": None, "seed": None, "amplitude_rad": None,
+           "kick_A": None, "dE_kT": None, "reason": ""}
     # the first time the rod left the circle, from the time series
     left_at = None
     ts = run.ts
@@ -146,9 +153,15 @@ def circle_stability(run):
             left_at is None or first.get("time_us", 0) <= left_at):
         out.update(verdict="stable" if first.get("stable") else "unstable",
                    time_us=first.get("time_us"), E_before_kT=first.get("E_total_before_kT"),
+                   E_reference_kT=first.get("E_total_continuation_kT",
+                                            first.get("E_total_before_kT")),
                    E_after_kT=first.get("E_total_after_kT"),
                    writhe_after=first.get("writhe_after"), seed=first.get("seed"),
-                   amplitude_rad=first.get("amplitude_rad"))
+                   amplitude_rad=first.get("amplitude_rad"), kick_A=first.get("kick_A"))
+        if first.get("E_difference_min_kT") is not None:
+            out["dE_kT"] = first["E_difference_min_kT"]
+        elif out["E_after_kT"] is not None and out["E_reference_kT"] is not None:
+            out["dE_kT"] = out["E_after_kT"] - out["E_reference_kT"]
         out["reason"] = "the stability test at the circle"
         return out
     if left_at is not None:

@@ -15,7 +15,8 @@ packages=(
   libopenmpi-dev openmpi-bin   # optional: mpirun -np K ibrod sweep (points shared among ranks)
   libfftw3-mpi-dev      # optional: distributed FFTs for large grids (docs/sweeps.md)
   libpng-dev            # rendered pictures of the rod
-  python3 python3-numpy python3-matplotlib python3-h5py   # analysis and plots
+  zlib1g-dev            # the animated PNG of render --movie (deflate, CRC)
+  python3 python3-numpy python3-matplotlib python3-h5py python3-pil   # analysis, plots; Pillow reads the movie in a test
   python3-dev pybind11-dev python3-pytest   # the Python module ibrod (docs/python.md) and its tests
   python3-mdanalysis    # tests: MDAnalysis reads trajectory.h5 (H5MD)
   python3-vtk9          # tests: VTK's own readers open the .vtp/.vti files

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <sstream>
 
 #include "core/error.hpp"
@@ -251,15 +252,17 @@ std::vector<fs::path> render_run(const fs::path& dir, const RenderOptions& opt, 
       }
   }
   const fs::path movie_file = out / ("rod_" + views.front().name + ".mp4");
+  const fs::path apng_file = out / ("rod_" + views.front().name + ".apng");
   if (!opt.force) {
     for (const auto& [file, i] : jobs)
       if (fs::exists(file))
         throw ConfigError("render: '" + file.string() +
                           "' exists (an earlier render, perhaps at another --size); give "
                           "--force to replace it, or move it away");
-    if (opt.movie && fs::exists(movie_file))
-      throw ConfigError("render: '" + movie_file.string() +
-                        "' exists; give --force to replace it, or move it away");
+    for (const fs::path& m : {movie_file, apng_file})
+      if (opt.movie && fs::exists(m))
+        throw ConfigError("render: '" + m.string() +
+                          "' exists; give --force to replace it, or move it away");
   }
   if (opt.movie) {
     fs::create_directories(movie_dir, ec);
@@ -289,6 +292,15 @@ std::vector<fs::path> render_run(const fs::path& dir, const RenderOptions& opt, 
   style.scale_bar = style.axis_triad = labels;
 
   std::vector<fs::path> written;
+  // the movie as an animated PNG too (any browser plays it; no ffmpeg needed), 10 frames/s
+  std::optional<render::ApngWriter> apng;
+  if (opt.movie) {
+    try {
+      apng.emplace(apng_file.string(), opt.width, opt.height, int(jobs.size()), 10);
+    } catch (const std::runtime_error& e) {
+      throw RunError(std::string("render: ") + e.what());
+    }
+  }
   for (std::size_t j = 0; j < jobs.size(); ++j) {
     const auto& [file, i] = jobs[j];
     const RodFrame& f = frames[i];
@@ -307,6 +319,7 @@ std::vector<fs::path> render_run(const fs::path& dir, const RenderOptions& opt, 
     }
     try {
       render::write_png(file.string(), img);
+      if (apng) apng->add(img);
     } catch (const std::runtime_error& e) {
       throw RunError(std::string("render: ") + e.what());
     }
@@ -325,14 +338,21 @@ std::vector<fs::path> render_run(const fs::path& dir, const RenderOptions& opt, 
       std::fprintf(log, "render: %zu frames (t = %s to %s us) in %s\n", frames.size(),
                    time_label(frames.front().time_us).c_str(),
                    time_label(frames.back().time_us).c_str(), movie_dir.c_str());
+    try {
+      apng->finish();
+    } catch (const std::runtime_error& e) {
+      throw RunError(std::string("render: ") + e.what());
+    }
+    if (log) std::fprintf(log, "%s\n", apng_file.c_str());
+    written.push_back(apng_file);
     if (const std::string mp4 = encode_movie(movie_dir, movie_file); !mp4.empty()) {
       if (log) std::fprintf(log, "%s\n", mp4.c_str());
       written.push_back(mp4);
     } else if (log) {
       std::fprintf(log,
                    "render: ffmpeg not found on PATH (Debian package ffmpeg), so no MP4: the "
-                   "frames are the movie (e.g. ffmpeg -framerate 10 -i %s/frame_%%05d.png "
-                   "-pix_fmt yuv420p %s)\n",
+                   "animated PNG above is the movie (or, later, ffmpeg -framerate 10 -i "
+                   "%s/frame_%%05d.png -pix_fmt yuv420p %s)\n",
                    movie_dir.c_str(), movie_file.c_str());
     }
   }

@@ -35,8 +35,9 @@ struct Config {
       1e-12;                        ///< time.stop_kinetic_kT: stop when E_K below, kT (0: never)
   bool time_stability_test = true;  ///< test a state before calling it an equilibrium
   double time_stability_amplitude_rad = 0.05;  ///< twist perturbation of the test, rad
-  double time_stability_probe_us = 0.5;        ///< how long the perturbed copy is integrated, µs
-  double time_stability_tolerance_kT = 1e-3;   ///< an energy drop beyond this: unstable, kT
+  double time_stability_kick_A = 1.0;          ///< out-of-plane position kick of the test, Å
+  double time_stability_probe_us = 2.0;        ///< how long both copies are integrated, µs
+  double time_stability_tolerance_kT = 1e-6;   ///< kicked below continuation by more: unstable, kT
   std::int64_t time_stability_seed = 1;        ///< seed of the test's perturbation
   std::string time_scheme = "explicit";        ///< time.scheme: "explicit" | "implicit" (issue 14)
   double time_max_displacement_A = 0;       ///< implicit: largest point move per step, Å (0: auto)
@@ -90,8 +91,8 @@ struct Config {
   double output_every_us = 0;
   double output_frame_every_us = 0;
   double output_checkpoint_every_us = 0;
-  bool output_fluid_vti = false;                       ///< fluid velocity .vti with every frame
-  bool output_fluid_velocity = false;                  ///< DIR/velocity.npy at the end (io/npy.hpp)
+  bool output_fluid_vti = false;       ///< fluid velocity .vti with every frame
+  bool output_fluid_velocity = false;  ///< DIR/velocity.npy at the end (io/npy.hpp)
   // [run]
   int run_threads = 0;           ///< 0: OpenMP default (OMP_NUM_THREADS or all cores)
   bool run_fftw_measure = true;  ///< FFTW_MEASURE plans (false: FFTW_ESTIMATE)
@@ -133,7 +134,8 @@ bool only_end_time_extended(const std::string& old_toml, const Config& now,
 sim::SimParams to_params(const Config& c);
 
 /// What `ibrod check` warns of (the run is allowed): a grid spacing larger than the hard core,
-/// a time step above the scheme's measured stability limit, a box that leaves the ring's periodic images within a few Debye lengths. One sentence each.
+/// a time step above the scheme's measured stability limit, a box that leaves the ring's periodic
+/// images within a few Debye lengths. One sentence each.
 std::vector<std::string> check_warnings(const Config& c);
 /// The largest time.dt_ns (ns) the configured scheme was measured stable at, scaled to the kernel
 /// width c (∝ c²; 0.22 ns explicit, 4.4 ns implicit at the reference grid; docs/config.md).

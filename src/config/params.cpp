@@ -143,6 +143,7 @@ sim::SimParams to_params(const Config& c) {
   p.stop_kinetic = c.time_stop_kinetic_kT * p.kT;
   p.stability.enabled = c.time_stability_test;
   p.stability.amplitude = c.time_stability_amplitude_rad;
+  p.stability.kick = c.time_stability_kick_A;
   p.stability.time = c.time_stability_probe_us * us;
   p.stability.tolerance = c.time_stability_tolerance_kT * p.kT;
   p.stability.seed = std::uint64_t(c.time_stability_seed);

@@ -324,11 +324,14 @@ const std::vector<Key>& schema() {
               "test a state the kinetic-energy rule calls an equilibrium by perturbing a copy "
               "(docs/config.md); false: stop at once"),
       real("time.stability_amplitude_rad", &Config::time_stability_amplitude_rad, 0, true, 1.0,
-           "twist amplitude of the stability test's perturbation, rad"),
+           "twist amplitude of the stability test's kick, rad"),
+      real("time.stability_kick_A", &Config::time_stability_kick_A, 0, true, 100.0,
+           "out-of-plane amplitude of the stability test's kick of the positions, Å"),
       real("time.stability_probe_us", &Config::time_stability_probe_us, 0, true, 1e3,
-           "how long the stability test integrates the perturbed state, µs"),
+           "how long the stability test integrates the kicked copy and the unperturbed one, µs"),
       real("time.stability_tolerance_kT", &Config::time_stability_tolerance_kT, 0, false, 1e6,
-           "energy drop during the stability test that makes a state unstable, kT"),
+           "how far the kicked copy's energy must end below the unperturbed one's to call the "
+           "state unstable, kT"),
       integer("time.stability_seed", &Config::time_stability_seed, 0,
               std::numeric_limits<std::int64_t>::max(),
               "seed of the stability test's perturbation"),

@@ -1,6 +1,7 @@
 #pragma once
 // An 8-bit RGB raster and its PNG file form (libpng).
 #include <cstdint>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -35,5 +36,25 @@ void write_png(const std::string& path, const Image& image);
 /// Reads any PNG as 8-bit RGB (palette, grey, 16-bit and alpha are converted; alpha is dropped).
 /// Throws std::runtime_error naming the file on failure.
 Image read_png(const std::string& path);
+
+/// An animated PNG (APNG: PNG 3rd edition's acTL/fcTL/fdAT chunks), written frame by frame so
+/// that a long movie is never held in memory: the frame count is fixed up front, every frame has
+/// the writer's size, each is shown for 1/fps s and the animation loops. Viewers without APNG
+/// support show the first frame. zlib compresses the rows (filter "none"). Throws
+/// std::runtime_error naming the file on an I/O error, std::invalid_argument on a frame of
+/// another size or a frame count that does not match.
+class ApngWriter {
+ public:
+  ApngWriter(const std::string& path, int width, int height, int frames, int fps);
+  void add(const Image& frame);
+  void finish();  ///< checks that every announced frame was added and closes the file
+
+ private:
+  void chunk(const char type[4], const std::vector<std::uint8_t>& data);
+  std::string path_;
+  std::ofstream out_;
+  int width_, height_, frames_, fps_, added_ = 0;
+  std::uint32_t sequence_ = 0;
+};
 
 }  // namespace ibrod::render

@@ -181,6 +181,16 @@ Observables Simulation::observe() {
   return o;
 }
 
+double Simulation::total_energy_kT() {
+  const double kT = p_.kT;
+  const auto el = rod::elastic_energy(p_.stepper.rod, rod_);
+  const double electro =
+      p_.stepper.electro.enabled ? stepper_.electrostatics().energy(rod_.X) / kT : 0.0;
+  const double steric = p_.stepper.steric.enabled ? stepper_.steric().energy(rod_.X) / kT : 0.0;
+  const double kinetic = stepper_.fluid_kinetic_energy() / kT;
+  return el.bend / kT + el.twist / kT + el.stretch / kT + electro + steric + kinetic;
+}
+
 StopReason Simulation::stop_reason(const Observables& o) const {
   if (step_ > 0 && o.E_kinetic_kT * p_.kT < p_.stop_kinetic) return StopReason::equilibrium;
   if (at_end()) return StopReason::end_time;

@@ -162,6 +162,9 @@ class Simulation {
   /// With a distributed fluid every rank must call step() and observe() alike (the kinetic
   /// energy is summed over the ranks).
   Observables observe();
+  /// E_total of observe() (the same terms, summed in the same order, so the same number) without
+  /// the O(n²) diagnostics: cheap enough for every few steps.
+  double total_energy_kT();
   /// The stop rules, checked at output steps (o: the row of the current step): E_K below the
   /// threshold after step 0 (equilibrium), else the end of the time (end_time), else none.
   StopReason stop_reason(const Observables& o) const;

@@ -1,8 +1,10 @@
 #include "sim/stability.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <vector>
@@ -16,23 +18,87 @@ namespace {
 
 double uniform01(std::mt19937_64& g) { return double(g() >> 11) * 0x1.0p-53; }
 
-// D_k ← R(g(s_k) D³_k) D_k with the drawn g (see the header)
-void perturb_twist(rod::RodState& s, const StabilityProbe& p, std::uint64_t index) {
-  std::mt19937_64 g(p.seed + index);
-  std::vector<double> u(std::size_t(p.modes)), phi(std::size_t(p.modes));
+// The kick of step 3 (see the header), drawn from g: positions out of the mean plane, triads
+// turned with their tangents, then the twist.
+void kick(rod::RodState& s, const StabilityProbe& p, std::mt19937_64& g) {
+  const int n = s.size();
+  const double phi2 = 2 * std::numbers::pi * uniform01(g);
+  const double u3 = 2 * uniform01(g) - 1;
+  const double phi3 = 2 * std::numbers::pi * uniform01(g);
+  std::vector<double> u(std::size_t(p.modes)), psi(std::size_t(p.modes));
   for (int m = 0; m < p.modes; ++m) {
     u[std::size_t(m)] = 2 * uniform01(g) - 1;
-    phi[std::size_t(m)] = 2 * std::numbers::pi * uniform01(g);
+    psi[std::size_t(m)] = 2 * std::numbers::pi * uniform01(g);
   }
-  const int n = s.size();
+  if (p.kick > 0 && n >= 3) {
+    Vec3 c = Vec3::Zero();
+    for (const Vec3& x : s.X) c += x;
+    c /= double(n);
+    Mat3 G = Mat3::Zero();
+    for (const Vec3& x : s.X) G += (x - c) * (x - c).transpose();
+    const Eigen::SelfAdjointEigenSolver<Mat3> eig(G);  // eigenvalues ascending
+    const Vec3 normal = eig.eigenvectors().col(0);
+    const Vec3 e1 = eig.eigenvectors().col(2), e2 = eig.eigenvectors().col(1);
+    auto tangent = [&](const std::vector<Vec3>& X, int k) {
+      return Vec3(X[std::size_t((k + 1) % n)] - X[std::size_t((k + n - 1) % n)]).normalized();
+    };
+    std::vector<Vec3> X = s.X;
+    for (int k = 0; k < n; ++k) {
+      const Vec3 r = s.X[std::size_t(k)] - c;
+      const double phi = std::atan2(r.dot(e2), r.dot(e1));
+      X[std::size_t(k)] +=
+          p.kick * (std::cos(2 * phi + phi2) + u3 * std::cos(3 * phi + phi3)) * normal;
+    }
+    for (int k = 0; k < n; ++k) {
+      const Vec3 t0 = tangent(s.X, k), t1 = tangent(X, k);
+      const Vec3 axis = t0.cross(t1);
+      const double angle = std::atan2(axis.norm(), t0.dot(t1));
+      if (axis.norm() > 0) s.D[k] = rotation(angle * axis.normalized()) * s.D[k];
+    }
+    s.X = std::move(X);
+  }
   for (int k = 0; k < n; ++k) {
     const double th = 2 * std::numbers::pi * double(k) / double(n);
-    double psi = 0;
+    double twist = 0;
     for (int m = 0; m < p.modes; ++m)
-      psi += u[std::size_t(m)] * std::sin(double(m + 1) * th + phi[std::size_t(m)]);
-    psi *= p.amplitude;
-    s.D[k] = rotation(psi * s.D[k].col(2)) * s.D[k];
+      twist += u[std::size_t(m)] * std::sin(double(m + 1) * th + psi[std::size_t(m)]);
+    twist *= p.amplitude;
+    s.D[k] = rotation(twist * s.D[k].col(2)) * s.D[k];
   }
+}
+
+// E_total along a copy's probe, sampled at the first step at or past each of kSamples equal
+// divisions of the probe time.
+constexpr int kSamples = 100;
+struct Trace {
+  std::vector<double> t, E;  ///< s, kT
+  /// E at time t, linear between the samples (held at the ends)
+  double at(double time) const {
+    if (time <= t.front()) return E.front();
+    if (time >= t.back()) return E.back();
+    const auto i = std::size_t(std::upper_bound(t.begin(), t.end(), time) - t.begin());
+    const double w = (time - t[i - 1]) / (t[i] - t[i - 1]);
+    return (1 - w) * E[i - 1] + w * E[i];
+  }
+};
+
+// Integrates sim from t0 until the probe time T has passed (whatever steps the scheme takes: with
+// an adaptive Δt the count is not known in advance), sampling E_total; returns the steps taken.
+std::int64_t integrate(Simulation& sim, double t0, double T, Trace& trace) {
+  std::int64_t steps = 0;
+  int next = 1;  // the next division to sample
+  for (;;) {
+    sim.step();
+    ++steps;
+    const double half = 0.5 * sim.dt();
+    if (sim.time() >= t0 + next * T / kSamples - half) {
+      trace.t.push_back(sim.time());
+      trace.E.push_back(sim.total_energy_kT());
+      while (next <= kSamples && sim.time() >= t0 + next * T / kSamples - half) ++next;
+    }
+    if (sim.time() >= t0 + T - half) break;
+  }
+  return steps;
 }
 
 }  // namespace
@@ -56,39 +122,54 @@ ProbeOutcome probe_stability(Simulation& sim, const StabilityProbe& p, std::uint
   const std::int64_t saved_step = sim.step_count();
   const double saved_time = sim.time();
   const auto saved_implicit = sim.implicit_state();  // time.scheme = "implicit": its controller
-
-  // 2. perturb, 3. integrate
-  perturb_twist(sim.rod(), p, index);
-  // until the probe time has passed (whatever steps the scheme takes: with an adaptive Δt the
-  // count is not known in advance)
-  const double t_end = saved_time + p.time;
-  do {
-    sim.step();
-    ++o.steps;
-  } while (sim.time() < t_end - 0.5 * sim.dt());
-  o.duration_us = (sim.time() - saved_time) / 1e-6;
-  const Observables after = sim.observe();
-  o.E_after_kT = after.E_total_kT;
-  o.writhe_after = after.writhe;
-
-  // 4. decide
-  o.stable = !(o.E_after_kT < o.E_before_kT - p.tolerance / kT);
-  if (o.stable) {
+  auto restore = [&] {
     sim.rod() = saved_rod;
     const double* v = saved_u.data();
     sim.stepper().set_whole_velocity({v, v + n3, v + 2 * n3});
     sim.restore_clock(saved_step, saved_time);
     sim.restore_implicit_state(saved_implicit);
+  };
+
+  // 2. the continuation
+  Trace cont, kicked;
+  o.continuation_steps = integrate(sim, saved_time, p.time, cont);
+  const Observables continuation = sim.observe();
+  o.E_continuation_kT = continuation.E_total_kT;
+  o.writhe_continuation = continuation.writhe;
+  restore();
+
+  // 3. the kicked copy
+  std::mt19937_64 g(p.seed + index);
+  kick(sim.rod(), p, g);
+  o.steps = integrate(sim, saved_time, p.time, kicked);
+  o.duration_us = (sim.time() - saved_time) / 1e-6;
+  const Observables after = sim.observe();
+  o.E_after_kT = after.E_total_kT;
+  o.writhe_after = after.writhe;
+
+  // 4. decide: the lowest the kicked copy came relative to the continuation, at any sample
+  o.min_difference_kT = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < kicked.t.size(); ++i) {
+    const double d = kicked.E[i] - cont.at(kicked.t[i]);
+    if (d < o.min_difference_kT) {
+      o.min_difference_kT = d;
+      o.min_difference_after_us = (kicked.t[i] - saved_time) / 1e-6;
+    }
   }
+  o.stable = !(o.min_difference_kT < -p.tolerance / kT);
+  if (o.stable) restore();
   return o;
 }
 
 std::string describe(const ProbeOutcome& o) {
-  char buf[256];
+  char buf[400];
   std::snprintf(buf, sizeof buf,
-                "%s: E_total %.6g -> %.6g kT, Wr %+.4f -> %+.4f over %lld steps from t = %.4f us",
-                o.stable ? "stable" : "unstable", o.E_before_kT, o.E_after_kT, o.writhe_before,
-                o.writhe_after, static_cast<long long>(o.steps), o.time_us);
+                "%s: the kicked copy's E_total minus the unperturbed continuation's: lowest %+.3g "
+                "kT (%.4g us after the kick), %+.3g kT at the end (%.4g us; continuation %.9g kT, "
+                "%.9g kT at the test); Wr %+.2e -> %+.2e (continuation %+.2e), from t = %.4f us",
+                o.stable ? "stable" : "unstable", o.min_difference_kT, o.min_difference_after_us,
+                o.E_after_kT - o.E_continuation_kT, o.duration_us, o.E_continuation_kT,
+                o.E_before_kT, o.writhe_before, o.writhe_after, o.writhe_continuation, o.time_us);
   return buf;
 }
 

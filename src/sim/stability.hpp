@@ -2,22 +2,41 @@
 // The stability-aware stop ([study]): E_K below time.stop_kinetic_kT is necessary for an
 // equilibrium, not sufficient — the twisted circle above the Michell threshold, or a symmetric
 // transient, is an unstable equilibrium at which E_K decays as a power law while the unstable
-// mode grows from almost nothing. So when the kinetic-energy rule fires, a copy of the state is
-// perturbed and integrated for a probe time:
+// mode grows from almost nothing. So when the kinetic-energy rule fires, the state is tested by
+// integrating two copies of it for a probe time T:
 //
-//   1. save the rod (X, D), the fluid velocity, the step and the time; E₀ = E_total of the state
-//   2. perturb the twist: D_k ← R(g(s_k) D³_k) D_k, g(s) = A Σ_{m=1..M} u_m sin(m s/r0 + φ_m),
-//      u_m uniform in [−1, 1) and φ_m uniform in [0, 2π) from std::mt19937_64(seed + probe
-//      index) (as rod/perturbation.hpp draws: 53-bit uniforms) — g is periodic with zero mean, so
-//      the link is unchanged; A is the amplitude (rad)
-//   3. integrate the probe time (the same Simulation::step); E₁ = E_total at its end
-//   4. unstable if E₁ < E₀ − tolerance (the state has somewhere lower to go); then the run goes
-//      on from the probe's end (its time included). Stable otherwise: the saved state is put
-//      back and the run stops as an equilibrium.
+//   1. save the rod (X, D), the fluid velocity, the clock and the implicit controller's state;
+//      E₀ = E_total of the state
+//   2. the continuation: integrate the state as it is for T; E_c = E_total at its end; put the
+//      saved state back
+//   3. the kicked copy: move the positions out of the rod's mean plane,
+//        δX_k = a n [cos(2φ_k + φ₂) + u₃ cos(3φ_k + φ₃)]
+//      (n the normal of the plane of least gyration, φ_k the azimuth of X_k about the centroid
+//      in that plane, a the amplitude in Å, u₃ uniform in [−1, 1), φ₂, φ₃ uniform in [0, 2π)),
+//      turn each triad by the smallest rotation that takes its old tangent to the new one (a pure
+//      bend, no twist), then perturb the twist: D_k ← R(g(s_k) D³_k) D_k,
+//      g(s) = A Σ_{m=1..M} u_m sin(m s/r0 + ψ_m) (zero mean: the link is unchanged; A in rad);
+//      all drawn from std::mt19937_64(seed + probe index), 53-bit uniforms; integrate for T;
+//      E₁ = E_total at its end
+//   4. both copies' E_total are sampled at 100 equal divisions of T; unstable if at any sample
+//      E₁(τ) < E_c(τ) − tolerance (E_c interpolated to the kicked copy's sample times): the
+//      kicked copy found somewhere lower to go than the unperturbed state does. Then the run
+//      goes on from the kicked copy's end (its time included). Stable otherwise: the saved
+//      state is put back and the run stops as an equilibrium.
 //
-// A stable state's kick relaxes back from above E₀ (E₁ ≥ E₀ up to dissipation of what was left
-// of the approach); an unstable one falls below it. The test is serial-only (a distributed fluid
-// would have to be gathered to be saved); deterministic, so a resumed run probes alike.
+// Why against the continuation and not against E₀: a state the rule stops at is still settling
+// (its energy keeps falling by more than the kick's signal), and near the Michell threshold the
+// unstable mode grows slowly (σ ≈ 0.18/µs at ΔLk = 2 for 600 bp), so the kick's energy changes
+// by ~1e-4 kT in 2 µs; both copies settle alike, so their difference isolates the kick. A
+// stable state's kick relaxes from above (E₁ − E_c = ½ δqᵀHδq > 0, decaying); an unstable one
+// crosses below. Why at any time and not only at T: a strongly unstable state (a small ring far
+// above the threshold) leaves on its own within T, round-off seeding the mode; the kicked copy
+// leaves first and is far below the continuation half-way, but by T both have reached the
+// same buckled state and their difference has either sign (measured: docs/study.md). The
+// out-of-plane kick seeds the writhing (figure-8, m = 2) mode directly; a twist kick alone reaches
+// it only through the twist–writhe coupling (docs/study.md measures both). The test is serial-only
+// (a distributed fluid would have to be gathered to be saved); deterministic, so a resumed run
+// probes alike.
 #include <cstdint>
 #include <string>
 
@@ -27,10 +46,11 @@ class Simulation;
 
 struct StabilityProbe {
   bool enabled = true;
-  double amplitude = 0.05;  ///< A, rad
+  double amplitude = 0.05;  ///< A, rad (the twist kick)
+  double kick = 1.0;        ///< a, Å (the out-of-plane kick of the positions)
   int modes = 4;            ///< M
-  double time = 0.5e-6;     ///< probe time, s
-  double tolerance = 0;     ///< energy drop that counts, g Å² s⁻²
+  double time = 2e-6;       ///< probe time T, s
+  double tolerance = 0;     ///< how far below the continuation counts, g Å² s⁻²
   std::uint64_t seed = 1;
 };
 
@@ -38,10 +58,14 @@ struct ProbeOutcome {
   bool stable = true;
   std::int64_t step = 0;   ///< the step the probe started at
   double time_us = 0;      ///< its time
-  std::int64_t steps = 0;  ///< steps integrated
-  double duration_us = 0;  ///< time integrated (≥ the probe time; adaptive Δt: not steps × Δt)
-  double E_before_kT = 0, E_after_kT = 0;
-  double writhe_before = 0, writhe_after = 0;
+  std::int64_t steps = 0;  ///< steps of the kicked copy
+  double duration_us = 0;  ///< time the kicked copy integrated (≥ T; adaptive Δt: not steps × Δt)
+  std::int64_t continuation_steps = 0;  ///< steps of the unperturbed continuation
+  double E_before_kT = 0, E_continuation_kT = 0, E_after_kT = 0;  ///< E₀, E_c, E₁
+  double writhe_before = 0, writhe_continuation = 0, writhe_after = 0;
+  /// the lowest E₁(τ) − E_c(τ) over the probe (kT; sampled 100 times, E_c interpolated to the
+  /// kicked copy's sample times) and when (µs after the kick)
+  double min_difference_kT = 0, min_difference_after_us = 0;
 };
 
 /// Runs the probe on `sim` (see the file comment); `index` counts the probes of the run (seed +
@@ -49,7 +73,7 @@ struct ProbeOutcome {
 /// not.
 ProbeOutcome probe_stability(Simulation& sim, const StabilityProbe& p, std::uint64_t index);
 
-/// One line for logs: "stable: E 1.23 → 1.25 kT over 0.5 µs" or "unstable: …".
+/// One line for logs: "stable: kicked − continuation = +3.7e-05 kT …" or "unstable: …".
 std::string describe(const ProbeOutcome& o);
 
 }  // namespace ibrod::sim

@@ -5,6 +5,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
 #include <fstream>
 #include <string>
 
@@ -59,6 +61,14 @@ TEST(StabilityTest, AnUnstableCircleIsNotCalledAnEquilibriumAndBuckles) {
   EXPECT_THAT(on.output, HasSubstr("not an equilibrium"));
   const std::string summary = read_file(d / "on" / "summary.json");
   EXPECT_THAT(summary, HasSubstr("\"stable\": false"));
+  // the evidence: the kicked copy came below the unperturbed continuation by more than the
+  // tolerance (1e-6 kT) at some time of the probe, and the lowest difference is the decision's
+  const auto first = nlohmann::json::parse(summary)["stability_tests"][0];
+  EXPECT_LT(first["E_difference_min_kT"].get<double>(), -1e-6) << first.dump();
+  EXPECT_LE(first["E_difference_min_kT"].get<double>(),
+            first["E_total_after_kT"].get<double>() -
+                first["E_total_continuation_kT"].get<double>() + 1e-9);
+  EXPECT_EQ(first["kick_A"].get<double>(), 1.0);
   EXPECT_THAT(summary, ::testing::Not(HasSubstr("\"stop_reason\": \"equilibrium\"")));
   EXPECT_GT(final_writhe(d / "on"), 0.5);
   EXPECT_NEAR(io::read_csv_table(d / "on" / "timeseries.csv").column("link").back(), 3.0, 1e-3);
@@ -74,9 +84,16 @@ TEST(StabilityTest, AStableCircleStopsAsAVerifiedEquilibriumAtTheTestedState) {
   EXPECT_THAT(summary, HasSubstr("\"stop_reason\": \"equilibrium\""));
   EXPECT_THAT(summary, HasSubstr("\"equilibrium_verified\": true"));
   EXPECT_THAT(summary, HasSubstr("\"stable\": true"));
+  // the kick's energy relaxed from above: never below the continuation by the tolerance, and
+  // the state tested is the one put back (its energy is the last row's)
+  const auto first = nlohmann::json::parse(summary)["stability_tests"][0];
+  EXPECT_GE(first["E_difference_min_kT"].get<double>(), -1e-6) << first.dump();
+  EXPECT_GT(first["E_total_after_kT"].get<double>(),
+            first["E_total_continuation_kT"].get<double>() - 1e-6);
   // the state put back is the one tested: the last row is the stop step's
   const io::CsvTable t = io::read_csv_table(d / "out" / "timeseries.csv");
   EXPECT_LT(t.column("step").back(), 1000);
   EXPECT_LT(std::abs(final_writhe(d / "out")), 1e-3);
+  EXPECT_NEAR(t.column("E_total_kT").back(), first["E_total_before_kT"].get<double>(), 1e-6);
   fs::remove_all(d);
 }

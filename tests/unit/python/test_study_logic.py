@@ -116,6 +116,21 @@ class CircleStability(unittest.TestCase):
         self.assertEqual(v["verdict"], "unstable")  # the later, stable test is of the buckled rod
         self.assertEqual((v["E_before_kT"], v["E_after_kT"], v["writhe_after"]), (150.0, 140.0, 1.5))
 
+    def test_the_energy_compared_is_the_continuation_s_when_recorded(self):
+        t = probe(0.06, True, e0=150.0, e1=149.5)
+        t["E_total_continuation_kT"] = 149.4  # the kicked copy ended above the continuation
+        v = st.circle_stability(run(dlk=1, tests=[t], writhes=[0.0, 0.0]))
+        self.assertEqual((v["E_before_kT"], v["E_reference_kT"], v["E_after_kT"]),
+                         (150.0, 149.4, 149.5))
+        self.assertAlmostEqual(v["dE_kT"], 0.1)
+        # the lowest difference during the probe decides when recorded (a strongly unstable
+        # state: both copies buckled by the end, the kicked one first)
+        t["E_difference_min_kT"] = -6.8
+        self.assertEqual(st.circle_stability(run(dlk=1, tests=[t], writhes=[0.0]))["dE_kT"], -6.8)
+        # a summary.json from before the continuation was recorded: the energy at the test
+        v = st.circle_stability(run(dlk=1, tests=[probe(0.06, True, e0=150.0)], writhes=[0.0]))
+        self.assertEqual(v["E_reference_kT"], 150.0)
+
     def test_a_first_test_after_the_rod_left_the_circle_does_not_decide(self):
         # no perturbation: the circle buckled on its own before the kinetic-energy rule fired
         r = run(dlk=3, tests=[probe(2.0, True, wr_before=1.5)], writhes=[0.0, 0.01, 0.2, 1.5])
