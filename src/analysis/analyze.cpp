@@ -57,6 +57,7 @@ RunInfo read_run_info(const fs::path& dir) {
   info.diameter_A = tbl["steric"]["diameter_A"].value<double>().value_or(info.diameter_A);
   info.excess_link = tbl["rod"]["excess_link"].value<int>().value_or(info.excess_link);
   info.salt_M = tbl["solvent"]["salt_M"].value<double>().value_or(info.salt_M);
+  info.closed = tbl["rod"]["closed"].value<bool>().value_or(info.closed);
   if (!(info.diameter_A > 0))
     throw ConfigError("'" + p.string() + "': steric.diameter_A must be positive");
   return info;

@@ -28,6 +28,7 @@ struct RunInfo {
   double diameter_A = 20.0;  ///< steric.diameter_A: the tube diameter in pictures
   int excess_link = 0;       ///< rod.excess_link
   double salt_M = 0;         ///< solvent.salt_M
+  bool closed = true;        ///< rod.closed (an open rod: no closing segment, no Wr or ΔLk)
 };
 /// Reads DIR/config.toml; defaults (diameter 20 Å) for a missing file or key. A file that is not
 /// TOML throws ConfigError.

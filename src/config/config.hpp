@@ -59,7 +59,8 @@ struct Config {
   double rod_intrinsic_twist_per_A = 0.0;           ///< Ω³₀, rad/Å
   std::vector<double> rod_intrinsic_curvature_per_A{0.0, 0.0};  ///< Ω¹₀, Ω²₀, rad/Å
   std::string
-      rod_initial_shape;  ///< rod.initial_shape: "" (the twisted circle) or a file (io/rod_shape)
+      rod_initial_shape;   ///< rod.initial_shape: "" (the twisted circle) or a file (io/rod_shape)
+  bool rod_closed = true;  ///< rod.closed: a closed ring, or an open rod with free ends
   // [solvent]
   double solvent_salt_M = 0.1;  ///< Cs, mol/L
   double solvent_viscosity_poise = 0.01;
@@ -90,8 +91,8 @@ struct Config {
   double output_every_us = 0;
   double output_frame_every_us = 0;
   double output_checkpoint_every_us = 0;
-  bool output_fluid_vti = false;                       ///< fluid velocity .vti with every frame
-  bool output_fluid_velocity = false;                  ///< DIR/velocity.npy at the end (io/npy.hpp)
+  bool output_fluid_vti = false;       ///< fluid velocity .vti with every frame
+  bool output_fluid_velocity = false;  ///< DIR/velocity.npy at the end (io/npy.hpp)
   // [run]
   int run_threads = 0;           ///< 0: OpenMP default (OMP_NUM_THREADS or all cores)
   bool run_fftw_measure = true;  ///< FFTW_MEASURE plans (false: FFTW_ESTIMATE)
@@ -133,7 +134,8 @@ bool only_end_time_extended(const std::string& old_toml, const Config& now,
 sim::SimParams to_params(const Config& c);
 
 /// What `ibrod check` warns of (the run is allowed): a grid spacing larger than the hard core,
-/// a time step above the scheme's measured stability limit, a box that leaves the ring's periodic images within a few Debye lengths. One sentence each.
+/// a time step above the scheme's measured stability limit, a box that leaves the ring's periodic
+/// images within a few Debye lengths. One sentence each.
 std::vector<std::string> check_warnings(const Config& c);
 /// The largest time.dt_ns (ns) the configured scheme was measured stable at, scaled to the kernel
 /// width c (∝ c²; 0.22 ns explicit, 4.4 ns implicit at the reference grid; docs/config.md).
