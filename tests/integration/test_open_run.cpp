@@ -98,6 +98,13 @@ TEST(OpenRun, RunDirectoryHasNoLinkAnOpenPolylineAndRefusesAClosedResume) {
   EXPECT_THAT(vtp, HasSubstr("Name=\"offsets\""));
   const auto off = vtp.find("Name=\"offsets\"");
   EXPECT_THAT(vtp.substr(off, 200), HasSubstr(">\n          50\n"));
+  // ibrod analyze: the ring's measures (shape class, stays_circular, writhe) are null
+  const Exit an = run_ibrod({"analyze", dir.string()}, root / "analyze.log");
+  ASSERT_EQ(an.code, 0) << an.output;
+  const std::string analysed = read_file(dir / "summary.json");
+  EXPECT_THAT(analysed, HasSubstr("\"stays_circular\": null"));
+  EXPECT_THAT(analysed, HasSubstr("\"shape\": null"));
+  EXPECT_THAT(analysed, HasSubstr("\"writhe_final\": null"));
   // resume as a closed rod: refused, even with --force
   const Exit r = run_ibrod({"run", "--resume", dir.string(), "--force", "--set", "rod.closed=true",
                             "--set", "rod.excess_link=0", "--set", "time.t_end_us=0.02"},
