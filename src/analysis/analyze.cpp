@@ -57,6 +57,7 @@ RunInfo read_run_info(const fs::path& dir) {
   info.diameter_A = tbl["steric"]["diameter_A"].value<double>().value_or(info.diameter_A);
   info.excess_link = tbl["rod"]["excess_link"].value<int>().value_or(info.excess_link);
   info.salt_M = tbl["solvent"]["salt_M"].value<double>().value_or(info.salt_M);
+  info.closed = tbl["rod"]["closed"].value<bool>().value_or(info.closed);
   if (!(info.diameter_A > 0))
     throw ConfigError("'" + p.string() + "': steric.diameter_A must be positive");
   return info;
@@ -126,7 +127,9 @@ Analysis analyze_timeseries(const CsvTable& table, const AnalyzeOptions& opt) {
 
   double max_wr = 0;
   for (double w : wr) max_wr = std::max(max_wr, std::abs(w));
-  a.stays_circular = max_wr < opt.circular_writhe;
+  // an open rod's writhe is not defined (empty fields, NaN): no ring to stay circular
+  a.open_rod = std::all_of(wr.begin(), wr.end(), [](double w) { return std::isnan(w); });
+  a.stays_circular = !a.open_rod && max_wr < opt.circular_writhe;
   if (a.stays_circular) {
     if (const auto fit = diagnostics::power_law_exponent(t, ek, opt.fit)) {
       a.kinetic_power_law_exponent = fit->exponent;
@@ -244,11 +247,14 @@ json to_json(const Analysis& a, const AnalyzeOptions& opt) {
   j["final_energies_kT"] = e;
   j["limiting_energies_kT"] = a.equilibrium ? e : json(nullptr);
   const ShapeAnalysis& sh = a.shapes;
-  j["shape"] =
-      sh.final_shape ? shape_json(sh.final_shape->shape, sh.final_shape->time_us) : json(nullptr);
+  // the shape classes are of closed curves (docs/analysis.md): null for an open rod
+  j["shape"] = sh.final_shape && !a.open_rod
+                   ? shape_json(sh.final_shape->shape, sh.final_shape->time_us)
+                   : json(nullptr);
   // null without --frames, so that an earlier analysis's frames do not outlive a new one
   json fr = opt.every_frame ? json::array() : json(nullptr);
-  for (const auto& f : sh.frames) fr.push_back(shape_json(f.shape, f.time_us));
+  if (!a.open_rod)
+    for (const auto& f : sh.frames) fr.push_back(shape_json(f.shape, f.time_us));
   j["shape_frames"] = fr;
   json contacts{{"distance_A", sh.contact_distance_A}};
   if (sh.contacts.time_us.empty()) {
@@ -266,7 +272,7 @@ json to_json(const Analysis& a, const AnalyzeOptions& opt) {
     contacts["changes"] = changes;
   }
   j["contacts"] = contacts;
-  j["stays_circular"] = a.stays_circular;
+  j["stays_circular"] = a.open_rod ? json(nullptr) : json(a.stays_circular);
   j["kinetic_power_law_exponent"] = optional_json(a.kinetic_power_law_exponent);
   j["kinetic_power_law_fit"] = fit_json(a.kinetic_power_law_fit);
   j["analysis"] = json{{"source", "timeseries.csv"},

@@ -28,6 +28,7 @@ struct RunInfo {
   double diameter_A = 20.0;  ///< steric.diameter_A: the tube diameter in pictures
   int excess_link = 0;       ///< rod.excess_link
   double salt_M = 0;         ///< solvent.salt_M
+  bool closed = true;        ///< rod.closed (an open rod: no closing segment, no Wr or ΔLk)
 };
 /// Reads DIR/config.toml; defaults (diameter 20 Å) for a missing file or key. A file that is not
 /// TOML throws ConfigError.
@@ -89,6 +90,8 @@ struct Analysis {
   double closest_approach_min_time_us = 0;
   std::vector<std::pair<std::string, double>> final_energies_kT;  ///< column name, last row
   bool stays_circular = false;  ///< |Wr| < AnalyzeOptions::circular_writhe throughout
+  bool open_rod = false;        ///< no writhe in the time series (rod.closed = false): null for the
+                          ///< ring's measures (stays_circular, shape, the power law)
   std::optional<double> kinetic_power_law_exponent;  ///< only for runs that stay circular
   std::optional<FitWindow> kinetic_power_law_fit;
 };

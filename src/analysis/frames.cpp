@@ -277,6 +277,7 @@ std::vector<fs::path> render_run(const fs::path& dir, const RenderOptions& opt, 
     for (const auto& f : frames) all_points.insert(all_points.end(), f.X.begin(), f.X.end());
 
   render::Style style;
+  style.closed = info.closed;
   if (opt.colour == "along")
     style.colouring = render::Colouring::along;
   else if (opt.colour == "height")
@@ -306,8 +307,13 @@ std::vector<fs::path> render_run(const fs::path& dir, const RenderOptions& opt, 
     const RodFrame& f = frames[i];
     if (labels) {
       char wr[64], lk[96];
-      std::snprintf(wr, sizeof wr, "Wr = %.3f", diagnostics::writhe(f.X));
-      std::snprintf(lk, sizeof lk, "ΔLk = %d   Cs = %g M", info.excess_link, info.salt_M);
+      if (info.closed) {
+        std::snprintf(wr, sizeof wr, "Wr = %.3f", diagnostics::writhe(f.X));
+        std::snprintf(lk, sizeof lk, "ΔLk = %d   Cs = %g M", info.excess_link, info.salt_M);
+      } else {  // an open rod: no writhe or link, its twist (docs/model.md "Open rods")
+        std::snprintf(wr, sizeof wr, "Tw = %.3f", diagnostics::twist_open(f.X, f.d1));
+        std::snprintf(lk, sizeof lk, "Cs = %g M", info.salt_M);
+      }
       style.labels = {"t = " + time_label(f.time_us) + " µs", wr, lk};
     }
     render::Image img;

@@ -60,7 +60,8 @@ struct Config {
   double rod_intrinsic_twist_per_A = 0.0;           ///< Ω³₀, rad/Å
   std::vector<double> rod_intrinsic_curvature_per_A{0.0, 0.0};  ///< Ω¹₀, Ω²₀, rad/Å
   std::string
-      rod_initial_shape;  ///< rod.initial_shape: "" (the twisted circle) or a file (io/rod_shape)
+      rod_initial_shape;   ///< rod.initial_shape: "" (the twisted circle) or a file (io/rod_shape)
+  bool rod_closed = true;  ///< rod.closed: a closed ring, or an open rod with free ends
   // [solvent]
   double solvent_salt_M = 0.1;  ///< Cs, mol/L
   double solvent_viscosity_poise = 0.01;

@@ -25,18 +25,39 @@ void validate(const Config& c) {
         "an integer m with 4m + 2 <= grid.n = " + std::to_string(c.grid_n) +
             " (the kernel must fit in the grid)");
   const double r0 = rod::circle_radius(c.rod_base_pairs, c.rod_rise_A);
-  // The ring plus its hard core must fit in the box; the key blamed is the one that grew past
-  // it: the hard core when the bare ring fits, else the box (naming the ring's keys).
-  if (2 * r0 < c.grid_box_A && 2 * r0 + c.steric_diameter_A >= c.grid_box_A)
-    bad("steric.diameter_A", fmt(c.steric_diameter_A),
-        "a hard core that leaves the ring (diameter " + fmt(2 * r0) +
-            " Å) inside the box: steric.diameter_A < grid.box_A - 2 r0 = " +
-            fmt(c.grid_box_A - 2 * r0) + " Å");
-  if (2 * r0 + c.steric_diameter_A >= c.grid_box_A)
-    bad("grid.box_A", fmt(c.grid_box_A),
-        "a box larger than the ring: rod.base_pairs = " + std::to_string(c.rod_base_pairs) +
-            " at rod.rise_A = " + fmt(c.rod_rise_A) + " gives a ring of diameter " + fmt(2 * r0) +
-            " Å (plus the hard core steric.diameter_A = " + fmt(c.steric_diameter_A) + " Å)");
+  if (!c.rod_closed) {
+    // docs/model.md "Open rods": no link to impose, and the implicit scheme's local solve is
+    // block-cyclic (a closed rod's)
+    if (c.rod_excess_link != 0)
+      bad("rod.excess_link", std::to_string(c.rod_excess_link),
+          "0 with rod.closed = false (an open rod has free ends: no linking number to impose)");
+    if (c.time_scheme == "implicit")
+      bad("time.scheme", "\"implicit\"",
+          "\"explicit\" with rod.closed = false (the implicit scheme's local solve is "
+          "block-cyclic, for a closed rod only; docs/model.md \"Open rods\")");
+    // the straight rod plus its hard core must fit in the box
+    const double length = (c.rod_base_pairs - 1) * c.rod_rise_A;
+    if (length + c.steric_diameter_A >= c.grid_box_A)
+      bad("grid.box_A", fmt(c.grid_box_A),
+          "a box longer than the open rod: rod.base_pairs = " + std::to_string(c.rod_base_pairs) +
+              " at rod.rise_A = " + fmt(c.rod_rise_A) + " gives a straight rod " + fmt(length) +
+              " Å long (plus the hard core steric.diameter_A = " + fmt(c.steric_diameter_A) +
+              " Å)");
+  }
+  if (c.rod_closed) {
+    // The ring plus its hard core must fit in the box; the key blamed is the one that grew past
+    // it: the hard core when the bare ring fits, else the box (naming the ring's keys).
+    if (2 * r0 < c.grid_box_A && 2 * r0 + c.steric_diameter_A >= c.grid_box_A)
+      bad("steric.diameter_A", fmt(c.steric_diameter_A),
+          "a hard core that leaves the ring (diameter " + fmt(2 * r0) +
+              " Å) inside the box: steric.diameter_A < grid.box_A - 2 r0 = " +
+              fmt(c.grid_box_A - 2 * r0) + " Å");
+    if (2 * r0 + c.steric_diameter_A >= c.grid_box_A)
+      bad("grid.box_A", fmt(c.grid_box_A),
+          "a box larger than the ring: rod.base_pairs = " + std::to_string(c.rod_base_pairs) +
+              " at rod.rise_A = " + fmt(c.rod_rise_A) + " gives a ring of diameter " + fmt(2 * r0) +
+              " Å (plus the hard core steric.diameter_A = " + fmt(c.steric_diameter_A) + " Å)");
+  }
   if (c.grid_box_A > kMaxBoxPerRise * c.rod_rise_A)
     bad("grid.box_A", fmt(c.grid_box_A),
         "at most " + fmt(kMaxBoxPerRise) + " rod.rise_A = " + fmt(kMaxBoxPerRise * c.rod_rise_A) +
@@ -91,7 +112,7 @@ void validate(const Config& c) {
   const double a3 = c.rod_twist_modulus_erg_cm * units::erg_cm;
   const double b = c.rod_shear_modulus_dyn * units::dyn;
   const double sin_beta = rod::circle_tilt_sin_beta(a, a3, b, r0, c.rod_excess_link);
-  if (!(std::abs(sin_beta) < 1))
+  if (c.rod_closed && !(std::abs(sin_beta) < 1))
     bad("rod.excess_link", std::to_string(c.rod_excess_link),
         "a link small enough that the twisted circle exists (|sin β| = " + fmt(std::abs(sin_beta)) +
             " >= 1)");
@@ -117,6 +138,7 @@ sim::SimParams to_params(const Config& c) {
   s.rod.b = Vec3(b, b, c.rod_stretch_modulus_dyn * dyn);
   s.rod.omega0 = Vec3(c.rod_intrinsic_curvature_per_A[0], c.rod_intrinsic_curvature_per_A[1],
                       c.rod_intrinsic_twist_per_A);
+  s.rod.closed = c.rod_closed;
   p.kT = kT(c.solvent_temperature_K);
   // MODEL (2.19–2.22): A = q²/(4π ε0 εw), κ = 0.329 √Cs
   s.electro = interactions::electro_params(c.electrostatics_enabled, c.electrostatics_charge_e,
@@ -126,6 +148,7 @@ sim::SimParams to_params(const Config& c) {
   s.steric.diameter = c.steric_diameter_A;
   s.steric.stiffness = c.steric_stiffness_kT_A2 * p.kT;
   s.steric.ds = s.rod.ds;
+  s.steric.closed = c.rod_closed;
   // docs/thermal.md: the random stress at kT, keyed by run.seed; the external load
   s.fluid.thermal_kT = c.solvent_thermal ? p.kT : 0.0;
   s.fluid.seed = std::uint64_t(c.run_seed);

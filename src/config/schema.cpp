@@ -373,6 +373,10 @@ const std::vector<Key>& schema() {
            "intrinsic twist Ω³₀, rad/Å (0: untwisted reference)"),
       intrinsic_curvature_key(),
       initial_shape_key(),
+      boolean("rod.closed", &Config::rod_closed,
+              "true: a closed ring; false: an open rod with two free ends, straight along x "
+              "unless rod.initial_shape gives its shape (needs rod.excess_link = 0 and "
+              "time.scheme = \"explicit\"; docs/model.md \"Open rods\")"),
       real("solvent.salt_M", &Config::solvent_salt_M, 0, false, 10.0,
            "monovalent salt concentration Cs, mol/L"),
       physical("solvent.viscosity_poise", &Config::solvent_viscosity_poise, 0.01, false,

@@ -1,4 +1,5 @@
-// Writhe, twist, linking number and closest approach of closed polygons (MODEL §6).
+// Writhe, twist, linking number and closest approach of closed polygons (MODEL §6); the twist,
+// closest approach and spacing of open ones.
 //
 // Solid angle of a segment pair. The Gauss integrand for the segments p1→p2 (r₁ = p1 + σ s) and
 // p3→p4 (r₂ = p3 + τ u) is minus the solid-angle element of the surface v(σ, τ) = r₂ − r₁, which
@@ -149,18 +150,44 @@ double twist(std::span<const Vec3> X, std::span<const Vec3> d1) {
   return angle / two_pi;
 }
 
-// Pairs i < j with cyclic distance min(j − i, n − (j − i)) ≥ m, i.e. i + m ≤ j ≤ i + n − m.
-ClosestPair closest_pair(std::span<const Vec3> X, int min_separation) {
+double twist_open(std::span<const Vec3> X, std::span<const Vec3> d1) {
+  const int n = int(X.size());
+  if (int(d1.size()) != n)
+    throw std::invalid_argument("diagnostics::twist_open: X and d1 differ in length");
+  if (n < 2) return 0.0;
+  std::vector<Vec3> t(n - 1);
+  for (int k = 0; k + 1 < n; ++k) t[k] = (X[k + 1] - X[k]).normalized();
+  double angle = 0.0;
+  for (int k = 0; k + 1 < n; ++k) {  // edge k, then vertex k+1 if it is interior
+    const Vec3& tk = t[k];
+    const Vec3 u = d1[k] - d1[k].dot(tk) * tk;
+    const Vec3 v = d1[k + 1] - d1[k + 1].dot(tk) * tk;
+    angle += signed_angle(u, v, tk);
+    if (k + 2 < n) {
+      const Vec3& tn = t[k + 1];
+      const Vec3 w = d1[k + 1] - d1[k + 1].dot(tn) * tn;
+      const Vec3 c = tk.cross(tn);
+      const Vec3 cv = c.cross(v);
+      const Vec3 Rv = v + cv + c.cross(cv) / (1.0 + tk.dot(tn));
+      angle += signed_angle(Rv, w, tn);
+    }
+  }
+  return angle / two_pi;
+}
+
+// Pairs i < j with cyclic distance min(j − i, n − (j − i)) ≥ m, i.e. i + m ≤ j ≤ i + n − m
+// (open: i + m ≤ j ≤ n − 1).
+ClosestPair closest_pair(std::span<const Vec3> X, int min_separation, bool closed) {
   const int n = int(X.size());
   const int m = std::max(min_separation, 1);
   ClosestPair best{std::numeric_limits<double>::infinity(), -1, -1};
-  if (n < 2 * m) return best;
+  if (closed ? n < 2 * m : n <= m) return best;
   std::vector<double> row_d2(n, std::numeric_limits<double>::infinity());
   std::vector<int> row_j(n, -1);
 #pragma omp parallel for schedule(dynamic, 16)
   for (int i = 0; i < n; ++i) {
     const Vec3 xi = X[i];
-    const int j1 = std::min(n - 1, i + n - m);
+    const int j1 = closed ? std::min(n - 1, i + n - m) : n - 1;
     double d2min = std::numeric_limits<double>::infinity();
     int jmin = -1;
     for (int j = i + m; j <= j1; ++j) {
@@ -179,16 +206,17 @@ ClosestPair closest_pair(std::span<const Vec3> X, int min_separation) {
   return best;
 }
 
-double closest_approach(std::span<const Vec3> X, int min_separation) {
-  return closest_pair(X, min_separation).distance;
+double closest_approach(std::span<const Vec3> X, int min_separation, bool closed) {
+  return closest_pair(X, min_separation, closed).distance;
 }
 
-double mean_spacing(std::span<const Vec3> X) {
+double mean_spacing(std::span<const Vec3> X, bool closed) {
   const int n = int(X.size());
   if (n < 2) return 0.0;
+  const int edges = closed ? n : n - 1;
   double sum = 0.0;
-  for (int k = 0; k < n; ++k) sum += (X[(k + 1) % n] - X[k]).norm();
-  return sum / n;
+  for (int k = 0; k < edges; ++k) sum += (X[(k + 1) % n] - X[k]).norm();
+  return sum / edges;
 }
 
 }  // namespace ibrod::diagnostics

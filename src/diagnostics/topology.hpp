@@ -26,6 +26,12 @@ double writhe(std::span<const Vec3> X);
 /// std::invalid_argument.
 double twist(std::span<const Vec3> X, std::span<const Vec3> d1);
 
+/// Twist of the ribbon (X, d1) about the open polygon X_0 … X_{n−1} (an open rod), in turns: the
+/// same sum as twist() over the n − 1 edges and the n − 2 interior vertices only (no closing edge).
+/// Not a topological quantity: an open rod has no link and no writhe that its ends cannot undo,
+/// and the total rotation of d1 is what is reported. 0 for n < 2.
+double twist_open(std::span<const Vec3> X, std::span<const Vec3> d1);
+
 /// Gauss linking number of two disjoint closed polygons A and B (exact solid-angle sum). O(n·m).
 /// Gauss's sign convention, shared with writhe and twist: +1 when B threads A once along A's
 /// right-hand normal, and +m for a planar curve and a d1 turning m times right-handedly about
@@ -33,11 +39,13 @@ double twist(std::span<const Vec3> X, std::span<const Vec3> d1);
 double linking_number(std::span<const Vec3> A, std::span<const Vec3> B);
 
 /// min |X_i − X_j| over pairs whose cyclic index distance is at least min_separation, Å. O(n²).
-/// +∞ when no pair qualifies (n < 2·min_separation); see closest_pair.
-double closest_approach(std::span<const Vec3> X, int min_separation);
+/// +∞ when no pair qualifies (n < 2·min_separation); see closest_pair. closed = false (an open
+/// rod): the index distance is |i − j|.
+double closest_approach(std::span<const Vec3> X, int min_separation, bool closed = true);
 
-/// mean |X_{k+1} − X_k| over the closed polygon, Å. O(n).
-double mean_spacing(std::span<const Vec3> X);
+/// mean |X_{k+1} − X_k| over the closed polygon (n edges), or over the open one's n − 1 edges, Å.
+/// O(n).
+double mean_spacing(std::span<const Vec3> X, bool closed = true);
 
 // ---- additions (the pieces the functions above are built from; exposed for tests and debugging)
 
@@ -57,6 +65,6 @@ struct ClosestPair {
 
 /// The pair that closest_approach measures. min_separation < 1 counts as 1 (distinct vertices);
 /// with no admissible pair (n < 2·min_separation) returns {+∞, −1, −1}. O(n²).
-ClosestPair closest_pair(std::span<const Vec3> X, int min_separation);
+ClosestPair closest_pair(std::span<const Vec3> X, int min_separation, bool closed = true);
 
 }  // namespace ibrod::diagnostics

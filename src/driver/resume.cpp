@@ -46,6 +46,22 @@ void Run::State::open_checkpoint() {
         std::to_string(ck.rod.size()) + " rod points; the configuration asks for grid.n = " +
         std::to_string(c.grid_n) + " and rod.base_pairs = " + std::to_string(c.rod_base_pairs) +
         ": incompatible, even with --force");
+  {
+    // a closed ring and an open rod are different structures: never continued into each other
+    config::Config old;
+    bool read = true;
+    try {
+      config::apply_toml(old, ck.meta.config_toml, cp.string());
+    } catch (const ConfigError&) {
+      read = false;  // reported below by config_differences
+    }
+    if (read && old.rod_closed != c.rod_closed)
+      throw ConfigError(std::string("resume: ") + cp.string() + " holds " +
+                        (old.rod_closed ? "a closed rod (rod.closed = true)"
+                                        : "an open rod (rod.closed = false)") +
+                        "; the configuration asks for rod.closed = " +
+                        (c.rod_closed ? "true" : "false") + ": incompatible, even with --force");
+  }
   const std::string diff = config::config_differences(ck.meta.config_toml, user, cp.string());
   config_changed = !diff.empty();
   // a later t_end alone extends the run: the continuation is the uninterrupted longer run

@@ -146,12 +146,21 @@ std::string Run::State::progress_line(const sim::Observables& o) const {
   const double ms = ms_per_step();
   const std::int64_t end = sim->end_step();
   char buf[320];
-  std::snprintf(buf, sizeof buf,
-                "step %lld/%lld  t = %.4f us  Wr = %+.4f  Lk = %+.4f  E_K = %.3e kT  "
-                "%.3f ms/step  ETA %s",
-                static_cast<long long>(sim->step_count()), static_cast<long long>(end),
-                sim->time() / 1e-6, o.writhe, o.link, o.E_kinetic_kT, ms,
-                format_duration(1e-3 * ms * double(end - sim->step_count())).c_str());
+  if (c.rod_closed)
+    std::snprintf(buf, sizeof buf,
+                  "step %lld/%lld  t = %.4f us  Wr = %+.4f  Lk = %+.4f  E_K = %.3e kT  "
+                  "%.3f ms/step  ETA %s",
+                  static_cast<long long>(sim->step_count()), static_cast<long long>(end),
+                  sim->time() / 1e-6, o.writhe, o.link, o.E_kinetic_kT, ms,
+                  format_duration(1e-3 * ms * double(end - sim->step_count())).c_str());
+  else  // an open rod: no writhe or link (docs/model.md "Open rods")
+    std::snprintf(buf, sizeof buf,
+                  "step %lld/%lld  t = %.4f us  Tw = %+.4f  E_el = %.4g kT  E_K = %.3e kT  "
+                  "%.3f ms/step  ETA %s",
+                  static_cast<long long>(sim->step_count()), static_cast<long long>(end),
+                  sim->time() / 1e-6, o.twist, o.E_bend_kT + o.E_twist_kT + o.E_stretch_kT,
+                  o.E_kinetic_kT, ms,
+                  format_duration(1e-3 * ms * double(end - sim->step_count())).c_str());
   if (sim->step_count() == start_step) {
     // before the first step of this process: the state's values, no timing yet
     std::string line(buf);
@@ -270,7 +279,9 @@ StopReason Run::State::test_stability(StopReason candidate) {
   say("ibrod: stability test at step " + std::to_string(o.step) + ": " + sim::describe(o) +
       (o.stable ? "; an equilibrium" : "; not an equilibrium, the run goes on from there"));
   if (o.stable) return candidate;
-  if (const std::string bad = sim::rod_problem(s.rod(), c.rod_rise_A); !bad.empty()) blow_up(bad);
+  if (const std::string bad = sim::rod_problem(s.rod(), c.rod_rise_A, 0.5, c.rod_closed);
+      !bad.empty())
+    blow_up(bad);
   last_row = observe_checked();
   record_row();
   check_link(last_row);
@@ -278,6 +289,7 @@ StopReason Run::State::test_stability(StopReason candidate) {
 }
 
 void Run::State::check_link(const sim::Observables& o) {
+  if (!c.rod_closed) return;  // an open rod has no linking number to conserve
   const double drift = std::abs(o.link - result.initial.link);
   meta.max_link_drift = std::max(meta.max_link_drift, drift);
   if (drift > kLinkDriftWarning && !meta.self_passage_warning) {
@@ -308,7 +320,7 @@ RunResult Run::State::loop(const std::function<int()>& pending, std::int64_t max
   try {
     ensure_space();
     if (!begun && result.resumed_from < 0) {
-      if (const std::string bad = sim::rod_problem(s.rod(), ds, tol); !bad.empty())
+      if (const std::string bad = sim::rod_problem(s.rod(), ds, tol, c.rod_closed); !bad.empty())
         blow_up("the initial state is not sane: " + bad);
       last_row = observe_checked();
       result.initial = meta.initial = last_row;
@@ -350,7 +362,8 @@ RunResult Run::State::loop(const std::function<int()>& pending, std::int64_t max
       }
       s.step();
       ++done;
-      if (const std::string bad = sim::rod_problem(s.rod(), ds, tol); !bad.empty()) blow_up(bad);
+      if (const std::string bad = sim::rod_problem(s.rod(), ds, tol, c.rod_closed); !bad.empty())
+        blow_up(bad);
       const bool segment_end = max_steps > 0 && done >= max_steps;
       const bool output_step = s.output_due() || segment_end;
       if (output_step) {
@@ -410,12 +423,21 @@ RunResult Run::State::loop(const std::function<int()>& pending, std::int64_t max
   }
 
   char buf[512];
-  std::snprintf(buf, sizeof buf,
-                "ibrod: stopped (%s) after %lld steps, t = %.4f us, Wr = %.4f, Tw = %.4f, "
-                "Lk = %.4f; %.1f s wall, %.3f ms/step",
-                to_string(result.reason).c_str(), static_cast<long long>(result.steps),
-                result.time_us, last_row.writhe, last_row.twist, last_row.link, result.wall_s,
-                result.ms_per_step);
+  if (c.rod_closed)
+    std::snprintf(buf, sizeof buf,
+                  "ibrod: stopped (%s) after %lld steps, t = %.4f us, Wr = %.4f, Tw = %.4f, "
+                  "Lk = %.4f; %.1f s wall, %.3f ms/step",
+                  to_string(result.reason).c_str(), static_cast<long long>(result.steps),
+                  result.time_us, last_row.writhe, last_row.twist, last_row.link, result.wall_s,
+                  result.ms_per_step);
+  else  // an open rod: no writhe or link (docs/model.md "Open rods")
+    std::snprintf(buf, sizeof buf,
+                  "ibrod: stopped (%s) after %lld steps, t = %.4f us, open rod: Tw = %.4f, "
+                  "E_elastic = %.4f kT; %.1f s wall, %.3f ms/step",
+                  to_string(result.reason).c_str(), static_cast<long long>(result.steps),
+                  result.time_us, last_row.twist,
+                  last_row.E_bend_kT + last_row.E_twist_kT + last_row.E_stretch_kT, result.wall_s,
+                  result.ms_per_step);
   say(buf);
   return result;
 }
@@ -428,7 +450,8 @@ Run::Run(const config::Config& c, const RunOptions& opt) {
     const std::string key = "rod.initial_shape";
     rod::RodState shape = io::read_rod_shape(c.rod_initial_shape, key);
     const std::string what = key + " = '" + c.rod_initial_shape + "'";
-    if (const std::string bad = sim::state_problem(shape, c.rod_base_pairs, c.rod_rise_A);
+    if (const std::string bad =
+            sim::state_problem(shape, c.rod_base_pairs, c.rod_rise_A, c.rod_closed);
         !bad.empty())
       throw ConfigError(what + ": " + bad +
                         " (rod.base_pairs = " + std::to_string(c.rod_base_pairs) +

@@ -109,7 +109,8 @@ class RunFiles {
     if (!frames_on_) return;
     const double t_us = sim.time() / 1e-6;
     h5_->write_frame(sim.step_count(), t_us, sim.rod());
-    rod_pvd_.add(sim.step_count(), t_us, io::rod_vtp(sim.rod(), ds_));
+    rod_pvd_.add(sim.step_count(), t_us,
+                 io::rod_vtp(sim.rod(), ds_, sim.params().stepper.rod.closed));
     if (vti_) fluid_pvd_.add(sim.step_count(), t_us, io::fluid_vti(sim.params().stepper.grid, u));
   }
 

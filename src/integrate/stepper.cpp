@@ -32,6 +32,13 @@ std::unique_ptr<fluid::DistributedFluid> make_distributed(const StepperParams& p
 ib::XSlab slab_of(const GridSpec& grid, const fluid::DistributedFluid* d) {
   return d ? ib::XSlab{d->x_begin(), d->x_count()} : ib::XSlab{0, grid.n};
 }
+
+// the hard core follows the rod: closed (cyclic segments) or open
+interactions::StericParams steric_of(const StepperParams& p) {
+  interactions::StericParams s = p.steric;
+  s.closed = p.rod.closed;
+  return s;
+}
 }  // namespace
 
 Stepper::Stepper(const StepperParams& p)
@@ -41,7 +48,7 @@ Stepper::Stepper(const StepperParams& p)
       coupler_(p.grid, p.kernel_width, slab_of(p.grid, dist_.get())),
       plane_coupler_(coupler_, p.rod.n),
       electro_(p.electro, p.rod.n),
-      steric_(p.steric, p.rod.n) {
+      steric_(steric_of(p), p.rod.n) {
   const int n = p.rod.n;
   work_.resize(n);
   F_.resize(n);

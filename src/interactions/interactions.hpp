@@ -163,16 +163,18 @@ struct StericParams {
   double diameter = 20.0;  ///< D, Å
   double stiffness = 0.0;  ///< g, g s⁻² (force per Å of overlap)
   double ds = 3.4;         ///< Δs of the rod, Å (pairs closer than 2D along the rod are skipped)
+  bool closed = true;  ///< closed rod (n segments, cyclic distance) or open (n − 1, |k − l|)
 };
 
-/// Hard-core repulsion between non-neighbouring segments [X_k, X_{k+1}] of the closed rod:
+/// Hard-core repulsion between non-neighbouring segments [X_k, X_{k+1}] of the rod (closed: k =
+/// 0 … n−1, X_n = X_0; open, StericParams::closed = false: k = 0 … n−2):
 /// for each pair of segments more than 2D apart along the rod whose closest points are at
 /// distance d < D, energy ½ g (D − d)² and the matching forces (−∂E/∂X) distributed to the
 /// segments' end points. Accumulates into F; returns the energy.
-/// Along-rod separation of segments k, l: min(|k − l|, n − |k − l|) Δs; the pair counts when
-/// it exceeds 2D. Candidates come from a cell list over segment midpoints with cell edge
-/// ≥ D + the longest segment (two segments closer than D have midpoints closer than that); with
-/// at most 2 cells per axis, a direct loop with the same midpoint test.
+/// Along-rod separation of segments k, l: min(|k − l|, n − |k − l|) Δs (open: |k − l| Δs); the pair
+/// counts when it exceeds 2D. Candidates come from a cell list over segment midpoints with cell
+/// edge ≥ D + the longest segment (two segments closer than D have midpoints closer than that);
+/// with at most 2 cells per axis, a direct loop with the same midpoint test.
 class Steric {
  public:
   Steric(const StericParams& p, int n);

@@ -80,11 +80,15 @@ double steric_pair(double D, double g, const Vec3& P0, const Vec3& P1, const Vec
 
 namespace {
 
-/// Whether segments k and l (of n, closed rod) are more than 2D apart along the rod.
-inline bool far_along_rod(int k, int l, int n, double ds, double D) {
+/// Whether segments k and l of a rod of n points are more than 2D apart along the rod (closed:
+/// the cyclic index distance; open: |k − l|).
+inline bool far_along_rod(int k, int l, int n, const StericParams& p) {
   const int m = std::abs(k - l);
-  return std::min(m, n - m) * ds > 2 * D;
+  return (p.closed ? std::min(m, n - m) : m) * p.ds > 2 * p.diameter;
 }
+
+/// Segments of a rod of n points: n closed (the last one X_{n−1} → X_0), n − 1 open.
+inline int segments(int n, const StericParams& p) { return p.closed ? n : n - 1; }
 
 /// Segment pair k, l: adds the forces on X_k, X_{k+1}, X_l, X_{l+1} into F (indexed by point);
 /// returns the energy.
@@ -116,9 +120,10 @@ double Steric::accumulate(std::span<const Vec3> X, std::span<Vec3> F) {
   const int n = int(X.size());
   if (!p_.enabled || n < 2 || !(p_.diameter > 0)) return 0;
   // midpoints and the longest segment: closest distance < D ⇒ midpoints < D + L_max apart
-  mid_.resize(n);
+  const int ns = segments(n, p_);
+  mid_.resize(ns);
   double lmax2 = 0;
-  for (int k = 0; k < n; ++k) {
+  for (int k = 0; k < ns; ++k) {
     const Vec3& a = X[k];
     const Vec3& b = X[(k + 1) % n];
     mid_[k] = 0.5 * (a + b);
@@ -126,23 +131,25 @@ double Steric::accumulate(std::span<const Vec3> X, std::span<Vec3> F) {
   }
   const double reach = p_.diameter + std::sqrt(lmax2);
   const double reach2 = reach * reach;
-  const detail::CellGrid g = detail::make_grid(mid_, reach, 4 * n + 64);
+  const detail::CellGrid g = detail::make_grid(mid_, reach, 4 * ns + 64);
   used_cells_ = !g.trivial();
   const StericParams p = p_;
   if (!used_cells_) {
+    // the loop runs over n (the force buffers' size); an open rod's point n−1 starts no segment
     return detail::parallel_pairs(n, F, thread_F_, thread_E_, [&](int k, Vec3* Ft, double& E) {
-      for (int l = k + 1; l < n; ++l)
-        if ((mid_[k] - mid_[l]).squaredNorm() < reach2 && far_along_rod(k, l, n, p.ds, p.diameter))
+      for (int l = k + 1; l < ns; ++l)
+        if ((mid_[k] - mid_[l]).squaredNorm() < reach2 && far_along_rod(k, l, n, p))
           E += segment_pair(p, X, k, l, Ft);
     });
   }
   detail::bin(g, mid_, cells_);
   const detail::CellScratch& c = cells_;
   return detail::parallel_pairs(n, F, thread_F_, thread_E_, [&](int a, Vec3* Ft, double& E) {
+    if (a >= ns) return;  // open rod: n − 1 segments, n force slots
     const int k = c.order[a];
     detail::for_each_partner(g, c, a, [&](int b) {
       const int l = c.order[b];
-      if ((c.x[a] - c.x[b]).squaredNorm() < reach2 && far_along_rod(k, l, n, p.ds, p.diameter))
+      if ((c.x[a] - c.x[b]).squaredNorm() < reach2 && far_along_rod(k, l, n, p))
         E += segment_pair(p, X, std::min(k, l), std::max(k, l), Ft);
     });
   });
@@ -153,9 +160,10 @@ double Steric::accumulate_direct(std::span<const Vec3> X, std::span<Vec3> F) con
   const int n = int(X.size());
   if (n < 2) return 0;
   double E = 0;
-  for (int k = 0; k < n; ++k)
-    for (int l = k + 1; l < n; ++l)
-      if (far_along_rod(k, l, n, p_.ds, p_.diameter)) E += segment_pair(p_, X, k, l, F.data());
+  const int ns = segments(n, p_);
+  for (int k = 0; k < ns; ++k)
+    for (int l = k + 1; l < ns; ++l)
+      if (far_along_rod(k, l, n, p_)) E += segment_pair(p_, X, k, l, F.data());
   return E;
 }
 
@@ -165,9 +173,10 @@ double Steric::energy(std::span<const Vec3> X) const {
   if (n < 2) return 0;
   double E = 0;
   std::array<Vec3, 4> f;
-  for (int k = 0; k < n; ++k)
-    for (int l = k + 1; l < n; ++l)
-      if (far_along_rod(k, l, n, p_.ds, p_.diameter))
+  const int ns = segments(n, p_);
+  for (int k = 0; k < ns; ++k)
+    for (int l = k + 1; l < ns; ++l)
+      if (far_along_rod(k, l, n, p_))
         E += steric_pair(p_.diameter, p_.stiffness, X[k], X[(k + 1) % n], X[l], X[(l + 1) % n], f);
   return E;
 }

@@ -4,6 +4,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <sstream>
 
 #include "core/error.hpp"
@@ -63,7 +64,18 @@ CsvTable read_csv_table(const fs::path& path) {
     const auto fields = split(line, ',');
     std::vector<double> v(fields.size());
     bool ok = fields.size() == t.names.size();
-    for (std::size_t k = 0; ok && k < fields.size(); ++k) ok = parse_double(fields[k], v[k]);
+    // an empty field is a value that is not defined (an open rod's writhe and link): NaN; on a
+    // last line without its newline it may be a row cut short, which is dropped below
+    const bool last_cut = in.peek() == EOF && !ends_in_newline;
+    for (std::size_t k = 0; ok && k < fields.size(); ++k) {
+      const std::string& f = fields[k];
+      if (f.empty() || f == "\r") {
+        v[k] = std::numeric_limits<double>::quiet_NaN();
+        ok = !last_cut;
+      } else {
+        ok = parse_double(f, v[k]);
+      }
+    }
     if (!ok) {
       if (in.peek() == EOF && !ends_in_newline) break;  // a row cut short by a killed run
       throw ConfigError("'" + path.string() + "' line " + std::to_string(lineno) + ": expected " +

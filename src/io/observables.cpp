@@ -1,5 +1,6 @@
 #include "io/observables.hpp"
 
+#include <cmath>
 #include <cstdio>
 
 namespace ibrod::io {
@@ -35,6 +36,11 @@ std::string timeseries_row(const sim::Observables& o) {
   std::snprintf(buf, sizeof buf, "%lld,%.10g", static_cast<long long>(o.step), o.time_us);
   std::string s = buf;
   for (const auto& f : observable_fields()) {
+    // NaN: not defined (an open rod's writhe and link; docs/outputs.md): an empty field
+    if (std::isnan(o.*f.member)) {
+      s += ',';
+      continue;
+    }
     std::snprintf(buf, sizeof buf, ",%.*g", f.csv_digits, o.*f.member);
     s += buf;
   }

@@ -52,10 +52,10 @@ double twist_density(const Mat3& Dk, const Mat3& Dk1, double ds) {
 
 }  // namespace
 
-std::string rod_vtp(const rod::RodState& s, double ds_A) {
+std::string rod_vtp(const rod::RodState& s, double ds_A, bool closed) {
   const int n = s.size();
   std::vector<double> omega(n), strain(n);
-  for (int k = 0; k < n; ++k) {
+  for (int k = 0; k < rod::half_points(n, closed); ++k) {
     const int k1 = k + 1 == n ? 0 : k + 1;
     omega[k] = twist_density(s.D[k], s.D[k1], ds_A);  // half point k+½
     strain[k] = (s.X[k1] - s.X[k]).norm() / ds_A - 1.0;
@@ -69,24 +69,31 @@ std::string rod_vtp(const rod::RodState& s, double ds_A) {
       "  <PolyData>\n";
   out += "    <Piece NumberOfPoints=\"" + std::to_string(n) +
          "\" NumberOfVerts=\"0\" NumberOfLines=\"1\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n";
+  if (!closed && n >= 2) {  // no half point n−½: the last point takes its one neighbour's
+    omega[n - 1] = omega[n - 2];
+    strain[n - 1] = strain[n - 2];
+  }
   out += "      <PointData Scalars=\"twist_density_rad_per_A\" Vectors=\"d3\">\n";
   const char* const triad_names[3] = {"d1", "d2", "d3"};
   for (int c = 0; c < 3; ++c) {
     data_array(out, "Float64", triad_names[c], 3, n,
                [&](std::size_t k, int i) { return s.D[k](i, c); });
   }
-  data_array(out, "Float64", "twist_density_rad_per_A", 1, n,
-             [&](std::size_t k, int) { return 0.5 * (omega[k] + omega[k == 0 ? n - 1 : k - 1]); });
+  data_array(out, "Float64", "twist_density_rad_per_A", 1, n, [&](std::size_t k, int) {
+    if (!closed && k == 0) return omega[0];  // an open rod's first point: no half point −½
+    return 0.5 * (omega[k] + omega[k == 0 ? n - 1 : k - 1]);
+  });
   data_array(out, "Float64", "stretch_strain", 1, n, [&](std::size_t k, int) { return strain[k]; });
   out += "      </PointData>\n      <Points>\n";
   data_array(out, "Float64", "Points", 3, n, [&](std::size_t k, int i) { return s.X[k][i]; });
   out += "      </Points>\n      <Lines>\n";
-  // closed polyline: the first point again at the end
+  // closed polyline: the first point again at the end; open: the n points alone
+  const std::size_t m = std::size_t(n) + (closed ? 1 : 0);
   data_array(
-      out, "Int64", "connectivity", 1, std::size_t(n) + 1,
+      out, "Int64", "connectivity", 1, m,
       [&](std::size_t k, int) { return double(k == std::size_t(n) ? 0 : k); }, "%.0f");
   data_array(
-      out, "Int64", "offsets", 1, 1, [&](std::size_t, int) { return double(n + 1); }, "%.0f");
+      out, "Int64", "offsets", 1, 1, [&](std::size_t, int) { return double(m); }, "%.0f");
   out += "      </Lines>\n    </Piece>\n  </PolyData>\n</VTKFile>\n";
   return out;
 }

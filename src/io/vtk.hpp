@@ -20,8 +20,10 @@ namespace ibrod::io {
 ///   d1, d2, d3                 triad columns D¹, D², D³ (3 components each)
 ///   twist_density_rad_per_A    Ω³, rad/Å: mean of the half points k−½ and k+½ (MODEL §4 strains)
 ///   stretch_strain             |X_{k+1} − X_k|/Δs − 1 of the segment from point k to k+1
-/// ds_A: the rest spacing Δs, Å.
-std::string rod_vtp(const rod::RodState& s, double ds_A);
+/// ds_A: the rest spacing Δs, Å. closed = false (an open rod): an open polyline (connectivity
+/// 0 … n−1, no closing segment); the end points' twist density is their one half point's, and
+/// the last point's stretch_strain that of the segment before it.
+std::string rod_vtp(const rod::RodState& s, double ds_A, bool closed = true);
 
 /// The fluid velocity as VTK XML ImageData on the grid points (origin 0, spacing h in Å), point
 /// data velocity_A_per_ns (3 components, Å/ns). u: the three components in Å/s, GridSpec::index

@@ -163,9 +163,11 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
   std::vector<float> param(style.colouring == Colouring::stripe ? 0 : depth.size(), 0.0f);
   // arc length of the nearest hit's axis point from X_0, for the outlines
   std::vector<float> arc(depth.size(), 0.0f);
+  // segments k → k+1: n of a closed polygon, n − 1 of an open one
+  const std::size_t segs = style.closed ? n : n - 1;
   std::vector<double> cum(n + 1, 0.0);
-  for (std::size_t k = 0; k < n; ++k) cum[k + 1] = cum[k] + (X[(k + 1) % n] - X[k]).norm();
-  const double arc_total = cum[n];
+  for (std::size_t k = 0; k < segs; ++k) cum[k + 1] = cum[k] + (X[(k + 1) % n] - X[k]).norm();
+  const double arc_total = cum[segs];
   double z_lo = std::numeric_limits<double>::infinity(), z_hi = -z_lo;
   // twist colouring: the twist density at each point (mean of its two segments), mapped from
   // the frame's lowest (0) to its highest (1); uniform twist: the middle of the map
@@ -174,6 +176,10 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
     const auto tw = twist_density(X, d1);
     tw_point.resize(n);
     for (std::size_t k = 0; k < n; ++k) tw_point[k] = 0.5 * (tw[(k + n - 1) % n] + tw[k]);
+    if (!style.closed) {  // the ends have one segment each
+      tw_point[0] = tw[0];
+      tw_point[n - 1] = tw[n - 2];
+    }
     const auto [lo, hi] = std::minmax_element(tw_point.begin(), tw_point.end());
     const double t_lo = *lo, t_hi = *hi, t_span = t_hi - t_lo;
     const bool uniform = !(t_span > 1e-6 * std::max(std::abs(t_lo), std::abs(t_hi)));
@@ -184,11 +190,13 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
   // vertex tangents (central differences), blended along each segment for smooth shading
   std::vector<Vec3> vtan(n);
   for (std::size_t k = 0; k < n; ++k) {
-    const Vec3 d = X[(k + 1) % n] - X[(k + n - 1) % n];
+    Vec3 d = X[(k + 1) % n] - X[(k + n - 1) % n];
+    if (!style.closed && k == 0) d = X[1] - X[0];  // open ends: one-sided
+    if (!style.closed && k == n - 1) d = X[n - 1] - X[n - 2];
     vtan[k] = d.norm() > 0 ? Vec3(d.normalized()) : Vec3(f);
   }
 
-  for (std::size_t k = 0; k < n; ++k) {
+  for (std::size_t k = 0; k < segs; ++k) {
     const Vec3& a = X[k];
     const Vec3& b = X[(k + 1) % n];
     const Vec3 ab = b - a;
@@ -245,7 +253,7 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
   const double arc_gap = style.outline_arc * diameter;
   const auto far_along = [&](float s1, float s2) {
     const double ds = std::abs(double(s1) - double(s2));
-    return std::min(ds, arc_total - ds) > arc_gap;
+    return (style.closed ? std::min(ds, arc_total - ds) : ds) > arc_gap;
   };
   if (style.outline_darken < 1) {
     const int reach = S;

@@ -66,9 +66,11 @@ struct Style {
                                     ///< below a quarter of the image width
   bool axis_triad = false;          ///< the lab axes x, y, z at the bottom right
   Rgb ink{40, 40, 40};              ///< labels, scale bar and axis triad
+  bool closed = true;  ///< X is a closed polygon (a ring); false: open (no segment X_{n−1} → X_0)
 };
 
-/// Renders the tube of diameter `diameter` (X's length unit) about the closed polygon X with the
+/// Renders the tube of diameter `diameter` (X's length unit) about the closed polygon X (open
+/// with style.closed = false: capped free ends, no closing segment) with the
 /// stripe along d1 (one director per point; interpolated along each segment and projected ⟂ to
 /// it), seen from `view`, into a width × height image. Tight framing: the box that the tube
 /// about the points `frame` (empty: X itself) covers on the image plane is centred and fills

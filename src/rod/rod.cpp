@@ -80,6 +80,40 @@ ElasticEnergy elastic_forces(const RodParams& p, const RodState& s, RodWork& w, 
     w.resize(n);  // allocates once; every later call with the same n reuses it
   const double half_ds = 0.5 * p.ds;
 
+  if (!p.closed) {
+    // Open rod: half points 0 … n−2; the ends have no half point beyond them (free ends).
+    const int m = half_points(n, false);
+#pragma omp parallel if (n >= 256)
+    {
+#pragma omp for schedule(static)
+      for (int k = 0; k < m; ++k) {
+        const HalfPoint h = eval_half(p, s.X[k], s.X[k + 1], s.D[k], s.D[k + 1]);
+        w.Dh[k] = h.Dh;
+        w.Xp[k] = h.Xp;
+        w.Fh[k] = h.Fh;
+        w.Nh[k] = h.Nh;
+        w.Eh[k] = h.E;
+      }
+#pragma omp for schedule(static)
+      for (int k = 0; k < n; ++k) {
+        Vec3 f = Vec3::Zero(), t = Vec3::Zero();
+        if (k < m) {
+          f += w.Fh[k];
+          t += w.Nh[k] + half_ds * w.Xp[k].cross(w.Fh[k]);
+        }
+        if (k > 0) {
+          f -= w.Fh[k - 1];
+          t += -w.Nh[k - 1] + half_ds * w.Xp[k - 1].cross(w.Fh[k - 1]);
+        }
+        F[k] += f;
+        T[k] += t;
+      }
+    }
+    Vec3 e = Vec3::Zero();
+    for (int k = 0; k < m; ++k) e += w.Eh[k];
+    return {e.x(), e.y(), e.z()};
+  }
+
   // One parallel region, two loops; below a few hundred points the fork/join costs more than the
   // work (at n = 600 one thread took 50 µs, two 36 µs).
 #pragma omp parallel if (n >= 256)
@@ -115,7 +149,7 @@ ElasticEnergy elastic_energy(const RodParams& p, const RodState& s) {
   const int n = s.size();
   check_size(s.D.size(), n, "D");
   Vec3 e = Vec3::Zero();
-  for (int k = 0; k < n; ++k) {
+  for (int k = 0; k < half_points(n, p.closed); ++k) {
     const int k1 = (k + 1 == n) ? 0 : k + 1;
     e += eval_half(p, s.X[k], s.X[k1], s.D[k], s.D[k1]).E;
   }
@@ -139,6 +173,27 @@ double circle_radius(int n, double ds) { return n * ds / (2.0 * std::numbers::pi
 double circle_tilt_sin_beta(double a1, double a3, double b1, double r0, double excess_link) {
   // MODEL §5: the tilt β of D³ out of the plane that balances twist against shear
   return -a3 * excess_link / (b1 * r0 * r0 + a3 - a1);
+}
+
+RodState straight_rod(const RodParams& p, const std::vector<double>& eps, const Vec3& center) {
+  const int n = p.n;
+  if (n < 2) throw ConfigError("rod: straight_rod needs n >= 2 points, got " + std::to_string(n));
+  if (!(p.ds > 0)) throw ConfigError("rod: straight_rod needs ds > 0 Å");
+  constexpr double two_pi = 2.0 * std::numbers::pi;
+  RodState s;
+  s.X.resize(n);
+  s.D.resize(n);
+  const Vec3 y(0.0, 1.0, 0.0), z(0.0, 0.0, 1.0);
+  for (int k = 0; k < n; ++k) {
+    double psi = 0;  // the circle's perturbation g(s), s/r0 = 2π k/n
+    for (std::size_t m = 0; m < eps.size(); ++m)
+      psi += eps[m] * std::sin(double(m + 1) * two_pi * k / n);
+    s.D[k].col(0) = std::cos(psi) * y + std::sin(psi) * z;
+    s.D[k].col(1) = -std::sin(psi) * y + std::cos(psi) * z;
+    s.D[k].col(2) = Vec3(1.0, 0.0, 0.0);
+    s.X[k] = center + Vec3((k - 0.5 * (n - 1)) * p.ds, 0.0, 0.0);
+  }
+  return s;
 }
 
 RodState twisted_circle(const RodParams& p, const CircleParams& c) {

@@ -1,6 +1,10 @@
 #pragma once
 // The special Cosserat rod of MODEL §3 (2.5–2.8, 2.13) discretised as in MODEL §4: a closed rod of
 // n points X_k with orthonormal triads D_k = [D¹ D² D³] (columns), spacing Δs along the rod.
+// Closed (the default: half points k+½ for k = 0 … n−1, indices cyclic) or open (RodParams::closed
+// = false: half points k+½ for k = 0 … n−2 only; the ends X_0, X_{n−1} have one neighbour, no
+// half point beyond them, so F_{−½} = F_{n−½} = 0 and N likewise: free, force- and torque-free
+// ends; docs/model.md "Open rods").
 // Internal force F and moment N live at half points k+½ with the half-point triad
 // D_{k+½} = √A D_k, A = D_{k+1} D_kᵀ (principal square root: half the angle about the same axis).
 #include <span>
@@ -16,7 +20,11 @@ struct RodParams {
   Vec3 a{1.3e5, 1.3e5, 1.82e5};  ///< a1, a2 (bending), a3 (twist), g Å³ s⁻²
   Vec3 b{5e3, 5e3, 5e3};         ///< b1, b2 (shear), b3 (stretch), g Å s⁻²
   Vec3 omega0{0.0, 0.0, 0.0};  ///< intrinsic curvatures Ω¹₀, Ω²₀ and twist Ω³₀, Å⁻¹
+  bool closed = true;          ///< closed ring (X_n = X_0) or open rod with two free ends
 };
+
+/// Number of half points (links k → k+1) of a rod of n points: n closed, n − 1 open.
+inline int half_points(int n, bool closed) { return closed ? n : (n > 0 ? n - 1 : 0); }
 
 struct RodState {
   std::vector<Vec3> X;  ///< [n] axis positions, Å (unwrapped: never folded into the box)
@@ -79,6 +87,13 @@ struct CircleParams {
   Vec3 center{0.0, 0.0, 0.0};             ///< Å
 };
 RodState twisted_circle(const RodParams& p, const CircleParams& c);
+
+/// Initial condition of an open rod (rod.closed = false): a straight rod along x, centred at
+/// `center`, points Δs apart, triads D¹ = ŷ, D² = ẑ, D³ = x̂ turned about x by the same twist
+/// perturbation as the circle's, ψ_k = Σ_m eps[m−1] sin(2π m k / n) (none when eps is empty).
+/// A stress-free state when p.omega0 = 0 and eps is empty. Throws ConfigError for n < 2 or
+/// ds ≤ 0.
+RodState straight_rod(const RodParams& p, const std::vector<double>& eps, const Vec3& center);
 
 /// Radius of the circle of n points Δs apart (Å): r0 = n Δs / 2π (MODEL §5).
 double circle_radius(int n, double ds);

@@ -12,7 +12,7 @@ double spacing_tolerance(const rod::RodParams& rod, double thermal_kT) {
   return std::max(0.5, 7.0 * std::sqrt(thermal_kT * rod.ds / b) / rod.ds);
 }
 
-std::string rod_problem(const rod::RodState& s, double ds, double tolerance) {
+std::string rod_problem(const rod::RodState& s, double ds, double tolerance, bool closed) {
   const double lo = std::max(0.05, 1.0 - tolerance), hi = 1.0 + tolerance;
   const int n = s.size();
   char buf[256];
@@ -24,7 +24,7 @@ std::string rod_problem(const rod::RodState& s, double ds, double tolerance) {
     }
     if (!s.D[k].allFinite()) return "the triad of point " + std::to_string(k) + " is not finite";
   }
-  for (int k = 0; k < n; ++k) {
+  for (int k = 0; k < rod::half_points(n, closed); ++k) {
     const int k1 = k + 1 == n ? 0 : k + 1;
     const double r = (s.X[k1] - s.X[k]).norm() / ds;
     if (!(r >= lo && r <= hi)) {
@@ -46,11 +46,11 @@ std::string rod_problem(const rod::RodState& s, double ds, double tolerance) {
   return {};
 }
 
-std::string state_problem(const rod::RodState& s, int n, double ds) {
+std::string state_problem(const rod::RodState& s, int n, double ds, bool closed) {
   if (s.size() != n || int(s.D.size()) != n)
     return std::to_string(s.size()) + " positions and " + std::to_string(s.D.size()) +
            " triads; the rod has " + std::to_string(n) + " points (rod.base_pairs)";
-  if (std::string bad = rod_problem(s, ds); !bad.empty()) return bad;
+  if (std::string bad = rod_problem(s, ds, 0.5, closed); !bad.empty()) return bad;
   for (int k = 0; k < n; ++k)
     if (const double det = s.D[k].determinant(); !(det > 0)) {
       char buf[160];

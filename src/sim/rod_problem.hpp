@@ -8,8 +8,10 @@ namespace ibrod::sim {
 
 /// Empty if the rod is sane; otherwise what is wrong, naming the point: a non-finite position or
 /// triad, an adjacent spacing off Δs by more than `tolerance` (relative; 50 % by default; never
-/// below 0.05 Δs), a triad off orthonormal by more than 1e-3.
-std::string rod_problem(const rod::RodState& s, double ds, double tolerance = 0.5);
+/// below 0.05 Δs), a triad off orthonormal by more than 1e-3. closed = false (an open rod): no
+/// spacing between the last point and the first.
+std::string rod_problem(const rod::RodState& s, double ds, double tolerance = 0.5,
+                        bool closed = true);
 
 /// The spacing tolerance of rod_problem for a run: 0.5, or with thermal noise (docs/thermal.md)
 /// seven standard deviations of the thermal stretch or shear of one segment,
@@ -20,6 +22,6 @@ double spacing_tolerance(const rod::RodParams& rod, double thermal_kT);
 /// Empty if `s` may be a rod of n points Δs = ds apart (an initial shape, a state set from
 /// Python); otherwise what is wrong: a count of positions or triads other than n, what
 /// rod_problem finds, or a left-handed triad (det D < 0: D³ must be D¹ × D²).
-std::string state_problem(const rod::RodState& s, int n, double ds);
+std::string state_problem(const rod::RodState& s, int n, double ds, bool closed = true);
 
 }  // namespace ibrod::sim

@@ -1,6 +1,7 @@
 #include "sim/simulation.hpp"
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <vector>
 
@@ -64,6 +65,9 @@ SimParams checked(SimParams p) {
     p.stability.enabled = false;
   }
   if (p.scheme == TimeScheme::implicit_step) {
+    if (!p.stepper.rod.closed)
+      throw std::invalid_argument(
+          "Simulation: the implicit scheme needs a closed rod (its local solve is block-cyclic)");
     if (p.stepper.distributed)
       throw std::invalid_argument("Simulation: the implicit scheme runs on one process only");
     integrate::AdaptiveDtParams& a = p.adaptive;
@@ -85,9 +89,14 @@ SimParams checked(SimParams p) {
 }  // namespace
 
 Simulation::Simulation(const SimParams& p)
-    : p_(checked(p)), rod_(rod::twisted_circle(p_.stepper.rod, p_.circle)), stepper_(p_.stepper) {
+    : p_(checked(p)),
+      rod_(p_.stepper.rod.closed
+               ? rod::twisted_circle(p_.stepper.rod, p_.circle)
+               : rod::straight_rod(p_.stepper.rod, p_.circle.perturbation, p_.circle.center)),
+      stepper_(p_.stepper) {
   // MODEL §6: the electrostatic energy is also reported relative to the circle at the same salt.
-  // The unperturbed circle (perturbation only rotates triads, so X is the same).
+  // The unperturbed circle (perturbation only rotates triads, so X is the same); for an open rod
+  // the straight rod.
   if (p_.stepper.electro.enabled) electro_circle_ = stepper_.electrostatics().energy(rod_.X);
   if (p_.scheme == TimeScheme::implicit_step)
     implicit_ = std::make_unique<integrate::ImplicitIntegrator>(stepper_, p_.implicit, p_.adaptive);
@@ -100,7 +109,9 @@ void Simulation::set_t_end(double t_end) {
 }
 
 void Simulation::set_rod_state(rod::RodState s, const std::string& what) {
-  if (const std::string bad = state_problem(s, p_.stepper.rod.n, p_.stepper.rod.ds); !bad.empty())
+  if (const std::string bad =
+          state_problem(s, p_.stepper.rod.n, p_.stepper.rod.ds, p_.stepper.rod.closed);
+      !bad.empty())
     throw std::invalid_argument(what + ": " + bad);
   rod_ = std::move(s);
   if (implicit_) implicit_->refresh();
@@ -173,11 +184,19 @@ Observables Simulation::observe() {
   const int n = rod_.size();
   std::vector<Vec3> d1(n);
   for (int k = 0; k < n; ++k) d1[k] = rod_.D[k].col(0);
-  o.writhe = diagnostics::writhe(rod_.X);
-  o.twist = diagnostics::twist(rod_.X, d1);
-  o.link = o.writhe + o.twist;
-  o.closest_approach_A = diagnostics::closest_approach(rod_.X, p_.closest_min_separation);
-  o.bp_spacing_A = diagnostics::mean_spacing(rod_.X);
+  const bool closed = p_.stepper.rod.closed;
+  if (closed) {
+    o.writhe = diagnostics::writhe(rod_.X);
+    o.twist = diagnostics::twist(rod_.X, d1);
+    o.link = o.writhe + o.twist;
+  } else {
+    // docs/model.md "Open rods": no link or writhe (not topological with free ends); NaN here is
+    // "not defined", written as an empty CSV field and null in JSON (io/observables)
+    o.writhe = o.link = std::numeric_limits<double>::quiet_NaN();
+    o.twist = diagnostics::twist_open(rod_.X, d1);
+  }
+  o.closest_approach_A = diagnostics::closest_approach(rod_.X, p_.closest_min_separation, closed);
+  o.bp_spacing_A = diagnostics::mean_spacing(rod_.X, closed);
   return o;
 }
 

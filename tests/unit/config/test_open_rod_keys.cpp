@@ -1,0 +1,84 @@
+// rod.closed (issue 17): an open rod reaches RodParams and StericParams, and the combinations an
+// open rod cannot have (an excess link, the implicit scheme, a box shorter than the rod) are
+// refused with an error naming both keys.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "config/config.hpp"
+#include "core/error.hpp"
+
+using namespace ibrod;
+using ::testing::HasSubstr;
+
+namespace {
+
+std::string validation_error(const config::Config& c) {
+  try {
+    config::validate(c);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+config::Config open_rod() {
+  config::Config c;
+  config::apply_override(c, "rod.closed=false");
+  config::apply_override(c, "rod.excess_link=0");
+  config::apply_override(c, "rod.base_pairs=200");  // a straight rod 677 Å long fits the box
+  return c;
+}
+
+}  // namespace
+
+TEST(OpenRodKeys, ClosedByDefaultOpenOnRequest) {
+  config::Config c;
+  EXPECT_TRUE(config::to_params(c).stepper.rod.closed);
+  EXPECT_TRUE(config::to_params(c).stepper.steric.closed);
+  const config::Config o = open_rod();
+  EXPECT_EQ(validation_error(o), "");
+  const sim::SimParams p = config::to_params(o);
+  EXPECT_FALSE(p.stepper.rod.closed);
+  EXPECT_FALSE(p.stepper.steric.closed);
+  EXPECT_THAT(config::describe(o), HasSubstr("rod.closed"));
+  EXPECT_THAT(config::to_toml(o), HasSubstr("closed = false"));
+  // written back and read again: the same configuration
+  config::Config back;
+  config::apply_toml(back, config::to_toml(o), "round trip");
+  EXPECT_FALSE(back.rod_closed);
+  EXPECT_THROW(config::apply_override(back, "rod.closed=1"), ConfigError);
+}
+
+TEST(OpenRodKeys, AnExcessLinkNeedsAClosedRod) {
+  config::Config c;
+  config::apply_override(c, "rod.closed=false");  // rod.excess_link is 6 by default
+  const std::string e = validation_error(c);
+  EXPECT_THAT(e, HasSubstr("rod.excess_link"));
+  EXPECT_THAT(e, HasSubstr("rod.closed = false"));
+  EXPECT_THAT(e, HasSubstr("6"));
+}
+
+TEST(OpenRodKeys, TheImplicitSchemeNeedsAClosedRod) {
+  config::Config c = open_rod();
+  config::apply_override(c, "time.scheme=\"implicit\"");
+  config::apply_override(c, "time.dt_ns=2");
+  const std::string e = validation_error(c);
+  EXPECT_THAT(e, HasSubstr("time.scheme"));
+  EXPECT_THAT(e, HasSubstr("rod.closed = false"));
+  EXPECT_THAT(e, HasSubstr("explicit"));
+}
+
+TEST(OpenRodKeys, TheStraightRodMustFitInTheBox) {
+  // 600 × 3.4 Å = 2037 Å of rod in the default 725 Å box: refused (a ring of that length fits)
+  config::Config c = open_rod();
+  config::apply_override(c, "rod.base_pairs=600");
+  const std::string e = validation_error(c);
+  EXPECT_THAT(e, HasSubstr("grid.box_A"));
+  EXPECT_THAT(e, HasSubstr("open rod"));
+  config::apply_override(c, "rod.base_pairs=200");  // 677 Å + 20 Å hard core < 725 Å
+  EXPECT_EQ(validation_error(c), "");
+  config::apply_override(c, "rod.base_pairs=210");  // 709.6 + 20 ≥ 725
+  EXPECT_THAT(validation_error(c), HasSubstr("grid.box_A"));
+}
