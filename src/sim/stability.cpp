@@ -20,7 +20,7 @@ double uniform01(std::mt19937_64& g) { return double(g() >> 11) * 0x1.0p-53; }
 
 // The kick of step 3 (see the header), drawn from g: positions out of the mean plane, triads
 // turned with their tangents, then the twist.
-void kick(rod::RodState& s, const StabilityProbe& p, std::mt19937_64& g) {
+void kick(rod::RodState& s, bool closed, const StabilityProbe& p, std::mt19937_64& g) {
   const int n = s.size();
   const double phi2 = 2 * std::numbers::pi * uniform01(g);
   const double u3 = 2 * uniform01(g) - 1;
@@ -39,8 +39,11 @@ void kick(rod::RodState& s, const StabilityProbe& p, std::mt19937_64& g) {
     const Eigen::SelfAdjointEigenSolver<Mat3> eig(G);  // eigenvalues ascending
     const Vec3 normal = eig.eigenvectors().col(0);
     const Vec3 e1 = eig.eigenvectors().col(2), e2 = eig.eigenvectors().col(1);
+    // central differences; one-sided at the free ends of an open rod
     auto tangent = [&](const std::vector<Vec3>& X, int k) {
-      return Vec3(X[std::size_t((k + 1) % n)] - X[std::size_t((k + n - 1) % n)]).normalized();
+      const int a = closed ? (k + n - 1) % n : std::max(k - 1, 0);
+      const int b = closed ? (k + 1) % n : std::min(k + 1, n - 1);
+      return Vec3(X[std::size_t(b)] - X[std::size_t(a)]).normalized();
     };
     std::vector<Vec3> X = s.X;
     for (int k = 0; k < n; ++k) {
@@ -140,7 +143,7 @@ ProbeOutcome probe_stability(Simulation& sim, const StabilityProbe& p, std::uint
 
   // 3. the kicked copy
   std::mt19937_64 g(p.seed + index);
-  kick(sim.rod(), p, g);
+  kick(sim.rod(), sim.params().stepper.rod.closed, p, g);
   o.steps = integrate(sim, saved_time, p.time, kicked);
   o.duration_us = (sim.time() - saved_time) / 1e-6;
   const Observables after = sim.observe();
