@@ -12,8 +12,12 @@
 //       the sampler's check against two exact identities of the Boltzmann distribution:
 //       ⟨Σ_k X_k·∂E/∂X_k⟩ = (3n − 3) kT (the virial: generalized equipartition, with the code's
 //       exact point forces), and ⟨Σ (L E)²⟩ = ⟨Σ L² E⟩ over the triads' rotation generators
-//       (configurational temperature, kT = 1). Prints both ratios with their blocked standard
-//       errors; exit status 1 if either ratio is off 1 by more than 4 standard errors or 3 %.
+//       (configurational temperature, kT = 1), and ⟨Σ |∂E/∂X|²⟩ = ⟨Σ ∂²E/∂X²⟩ (the same for the
+//       positions). Prints the three ratios with their blocked standard errors; exit status 1 if
+//       a configurational temperature is off 1 by more than 4 standard errors or 3 %, the virial by
+//       more than 4 standard errors or 5 %, or
+//       if a triad drifted off SO(3) by 1e-9 or the running pair energy off its full sum by 1e-8
+//       kT.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -46,17 +50,19 @@ MeanErr blocked(const std::vector<double>& x) {
 
 void print_rates(const mc::RingMC& mc, const char* when) {
   const auto& c = mc.counts();
-  const char* names[4] = {"crankshaft", "twist", "tilt", "shift"};
+  const char* names[6] = {"crankshaft", "twist", "tilt", "shift", "spin", "dilate"};
   std::fprintf(stderr, "%s: acceptance", when);
-  for (int w = 0; w < 4; ++w)
+  for (int w = 0; w < 6; ++w)
     std::fprintf(stderr, " %s %.3f", names[w],
                  c.tried[w] ? double(c.accepted[w]) / double(c.tried[w]) : 0.0);
   std::fprintf(stderr,
-               "; steps: crank %.3f rad, twist %.3f rad, tilt %.4f rad, shift %.3f Å; "
+               "; steps: crank %.3f rad, twist %.3f rad, tilt %.4f rad, shift %.3f Å, spin %.3f "
+               "rad, dilate %.4f; "
                "Lk checks %lld, moves rejected for Lk %lld; incremental pair energy off the "
-               "full sum by at most %.2g kT\n",
+               "full sum by at most %.2g kT; triads off orthonormal by at most %.2g\n",
                mc.steps().crank, mc.steps().twist, mc.steps().tilt, mc.steps().shift,
-               (long long)c.lk_checks, (long long)c.lk_rejects, mc.max_pair_drift());
+               mc.steps().spin, mc.steps().dilate, (long long)c.lk_checks, (long long)c.lk_rejects,
+               mc.max_pair_drift(), mc.max_triad_drift());
 }
 
 int selftest(std::map<std::string, std::string>& kv) {
@@ -95,9 +101,12 @@ int selftest(std::map<std::string, std::string>& kv) {
   const MeanErr c = blocked(psq), d = blocked(plap);
   const double rp = c.mean / d.mean, rp_err = rp * std::hypot(c.err / c.mean, d.err / d.mean);
   std::printf("positional configurational temperature / T = %.4f +- %.4f\n", rp, rp_err);
-  // the virial is printed (its variance is large: X·∇E has a term linear in the stiff stretch);
-  // the two configurational temperatures are the test
-  const bool ok = std::abs(rr - 1) < 4 * rr_err && std::abs(rr - 1) < 0.03 &&
+  std::printf(
+      "triads off orthonormal by at most %.2g; running pair energy off by at most %.2g kT\n",
+      mc.max_triad_drift(), mc.max_pair_drift());
+  const bool ok = mc.max_triad_drift() < 1e-9 && mc.max_pair_drift() < 1e-8 &&
+                  std::abs(rv - 1) < 4 * rv_err && std::abs(rv - 1) < 0.05 &&
+                  std::abs(rr - 1) < 4 * rr_err && std::abs(rr - 1) < 0.03 &&
                   std::abs(rp - 1) < 4 * rp_err && std::abs(rp - 1) < 0.03;
   std::printf("%s\n", ok ? "selftest passed" : "selftest FAILED");
   return ok ? 0 : 1;
@@ -150,7 +159,9 @@ int main(int argc, char** argv) try {
   std::fprintf(f,
                "sweep,writhe,twist,link,rg2_A2,P1_A2,P2_A2,P3_A2,P4_A2,E_bend_kT,E_twist_kT,"
                "E_stretch_kT,E_pairs_kT\n");
+  const long debug_from = kv.count("debug_from") ? std::stol(kv["debug_from"]) : -1;
   for (long i = 1; i <= sweeps; ++i) {
+    if (i == debug_from) mc.debug_ = true;
     mc.sweep();
     if (i % every) continue;
     const mc::RingSample r = mc::measure(E, mc.state());
@@ -159,6 +170,19 @@ int main(int argc, char** argv) try {
                  r.E_bend, r.E_twist, r.E_stretch, r.E_pairs);
   }
   std::fclose(f);
+  if (kv.count("final")) {  // the last state: x y z, D¹, D², D³ per point
+    std::FILE* g = std::fopen(kv["final"].c_str(), "w");
+    if (!g) return std::fprintf(stderr, "cannot write %s\n", kv["final"].c_str()), 1;
+    for (int k = 0; k < mc.state().size(); ++k) {
+      const Vec3& x = mc.state().X[k];
+      const Mat3& D = mc.state().D[k];
+      std::fprintf(g, "%.12g %.12g %.12g", x[0], x[1], x[2]);
+      for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < 3; ++r) std::fprintf(g, " %.12g", D(r, c));
+      std::fprintf(g, "\n");
+    }
+    std::fclose(g);
+  }
   print_rates(mc, "production");
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::fprintf(stderr, "Lk0 = %.6f; %ld + %ld sweeps of %d points, %.1f s (%.2f ms/sweep)\n",

@@ -1,9 +1,11 @@
 #include "mc_sampler.hpp"
 
 #include <Eigen/Geometry>
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <cstdio>
 #include <numbers>
 
 #include "diagnostics/topology.hpp"
@@ -224,7 +226,7 @@ bool RingMC::crank() {
 bool RingMC::twist_move() {
   const int k = std::uniform_int_distribution<int>(0, s_.size() - 1)(rng_);
   const double ph = std::uniform_real_distribution<double>(-steps_.twist, steps_.twist)(rng_);
-  trial_.D[k] = rotation(s_.D[k].col(2), ph) * s_.D[k];
+  trial_.D[k] = rotation(s_.D[k].col(2).normalized(), ph) * s_.D[k];
   const double e_el = E_.elastic(trial_);  // the pair energies do not see the triads
   const bool ok = accept(e_el - e_el_);
   if (ok)
@@ -269,14 +271,69 @@ bool RingMC::shift_move() {
   return ok;
 }
 
+bool RingMC::spin_move() {
+  const int n = s_.size();
+  std::uniform_int_distribution<int> pick_i(0, n - 1), pick_m(1, n / 2);
+  const int i = pick_i(rng_), m = pick_m(rng_);
+  const double ph = std::uniform_real_distribution<double>(-steps_.spin, steps_.spin)(rng_);
+  for (int q = 0; q < m; ++q) {
+    const int k = (i + q) % n;
+    trial_.D[k] = rotation(s_.D[k].col(2).normalized(), ph) * s_.D[k];
+  }
+  const double e_el = E_.elastic(trial_);
+  const bool ok = accept(e_el - e_el_);
+  for (int q = 0; q < m; ++q) {
+    const int k = (i + q) % n;
+    if (ok)
+      s_.D[k] = trial_.D[k];
+    else
+      trial_.D[k] = s_.D[k];
+  }
+  if (ok) e_el_ = e_el;
+  return ok;
+}
+
+bool RingMC::dilate_move() {
+  const int n = s_.size();
+  const double u = std::uniform_real_distribution<double>(-steps_.dilate, steps_.dilate)(rng_);
+  Vec3 c = Vec3::Zero();
+  for (const Vec3& x : s_.X) c += x / n;
+  const double lam = std::exp(u);
+  for (int k = 0; k < n; ++k) trial_.X[k] = c + lam * (s_.X[k] - c);
+  const double e_el = E_.elastic(trial_), e_pair = E_.pairs(trial_.X);
+  const double e_steric = E_.steric_only(trial_.X);
+  double max_path = 0;
+  for (int k = 0; k < n; ++k) max_path = std::max(max_path, (trial_.X[k] - s_.X[k]).norm());
+  // Metropolis–Hastings: the map's Jacobian e^{(3n−3)u} on the relative coordinates
+  bool ok = accept(e_el + e_pair - e_el_ - e_pair_ - (3.0 * n - 3.0) * u);
+  if (ok && link_changed(max_path, e_steric)) ok = false;
+  for (int k = 0; k < n; ++k) {
+    if (ok)
+      s_.X[k] = trial_.X[k];
+    else
+      trial_.X[k] = s_.X[k];
+  }
+  if (ok) e_el_ = e_el, e_pair_ = e_pair, e_steric_ = e_steric;
+  return ok;
+}
+
 void RingMC::sweep(bool adapt) {
   const int n = s_.size();
   const McCounts before = counts_;
   std::uniform_int_distribution<int> kind(0, 3);
-  for (int t = 0; t < 4 * n; ++t) {
-    const int w = kind(rng_);
+  const int big = std::max(1, n / 10);
+  std::uniform_int_distribution<int> any(0, 4 * n + 2 * big - 1);
+  for (int t = 0; t < 4 * n + 2 * big; ++t) {
+    const int r = any(rng_);
+    const int w = r < 4 * n ? kind(rng_) : (r < 4 * n + big ? 4 : 5);
     bool ok = false;
     switch (w) {
+      case 4:
+        ok = spin_move();
+        break;
+      case 5:
+        ok = dilate_move();
+        break;
       case 0:
         ok = crank();
         break;
@@ -292,16 +349,34 @@ void RingMC::sweep(bool adapt) {
     }
     ++counts_.tried[w];
     if (ok) ++counts_.accepted[w];
+    if (debug_) {
+      const double a = E_.elastic(s_), b = E_.pairs(s_.X);
+      bool sync = true;
+      for (int k = 0; k < n; ++k) sync = sync && s_.X[k] == trial_.X[k] && s_.D[k] == trial_.D[k];
+      if (std::abs(a - e_el_) > 1e-7 || std::abs(b - e_pair_) > 1e-7 || !sync)
+        std::fprintf(stderr, "move %d ok %d: elastic %.9g vs %.9g, pairs %.9g vs %.9g, sync %d\n",
+                     w, int(ok), a, e_el_, b, e_pair_, int(sync));
+    }
   }
   if (adapt) {
-    double* step[4] = {&steps_.crank, &steps_.twist, &steps_.tilt, &steps_.shift};
-    for (int w = 0; w < 4; ++w) {
+    double* step[6] = {&steps_.crank, &steps_.twist, &steps_.tilt,
+                       &steps_.shift, &steps_.spin,  &steps_.dilate};
+    for (int w = 0; w < 6; ++w) {
       const double tried = double(counts_.tried[w] - before.tried[w]);
       if (tried == 0) continue;
       const double rate = double(counts_.accepted[w] - before.accepted[w]) / tried;
       *step[w] *= std::clamp(std::exp(rate - 0.4), 0.8, 1.25);
-      if (w == 0 || w == 1 || w == 2) *step[w] = std::min(*step[w], std::numbers::pi);
+      if (w != 3 && w != 5) *step[w] = std::min(*step[w], std::numbers::pi);
     }
+  }
+  // Products of many rotations drift off SO(3) by round-off (and a rotation about a D³ that is
+  // not exactly unit is not orthogonal: the error would feed on itself): put each triad back on
+  // the nearest rotation, U Vᵀ of its SVD, recording how far off it was.
+  for (int k = 0; k < n; ++k) {
+    const double off = (s_.D[k].transpose() * s_.D[k] - Mat3::Identity()).cwiseAbs().maxCoeff();
+    max_triad_drift_ = std::max(max_triad_drift_, off);
+    Eigen::JacobiSVD<Mat3> svd(s_.D[k], Eigen::ComputeFullU | Eigen::ComputeFullV);
+    s_.D[k] = trial_.D[k] = svd.matrixU() * svd.matrixV().transpose();
   }
   // the pair energy is kept incrementally: check it against the full sums and refresh it
   e_el_ = E_.elastic(s_);

@@ -13,7 +13,14 @@
 //   twist       one triad turned by φ ∈ U(−δ_t, δ_t) about its own D³ (D³ unchanged);
 //   tilt        one triad turned by φ ∈ U(−δ_r, δ_r) about a uniformly random axis (shear of D³
 //               against the tangent, and the bend/twist strains it carries);
-//   shift       one point displaced by U(−δ_x, δ_x)³ (stretch and shear).
+//   shift       one point displaced by U(−δ_x, δ_x)³ (stretch and shear);
+//   spin        the triads of an arc of m = 1 … n/2 points each turned by the same φ ∈ U(−δ_s, δ_s)
+//               about its own D³ (moves twist between the arc's ends in one step: single twist
+//               moves alone relax the ring's twist profile diffusively, slowly);
+//   dilate      all points scaled about their centroid by e^u, u ∈ U(−δ_u, δ_u), triads kept
+//               (the ring's size: single shifts relax it slowly); Metropolis–Hastings with the
+//               Jacobian e^{(3n−3)u} of the map, min(1, e^{−ΔE/kT + (3n−3)u}).
+// A sweep is n attempts of each of the first four kinds and n/10 of the last two.
 // The step sizes adapt during burn-in only (towards 40 % acceptance) and are frozen afterwards.
 // Linking number: a move that changes Lk is rejected. Lk = Tw + Wr (O(n²)) is recomputed for a
 // position move only when it could have passed the rod through itself: when a non-local segment
@@ -77,14 +84,16 @@ struct RingEnergy {
 };
 
 struct McSteps {
-  double crank = 0.2;  ///< δ_c, rad
-  double twist = 0.3;  ///< δ_t, rad
-  double tilt = 0.05;  ///< δ_r, rad
-  double shift = 0.3;  ///< δ_x, Å
+  double crank = 0.2;    ///< δ_c, rad
+  double twist = 0.3;    ///< δ_t, rad
+  double tilt = 0.05;    ///< δ_r, rad
+  double shift = 0.3;    ///< δ_x, Å
+  double spin = 0.1;     ///< δ_s, rad
+  double dilate = 0.01;  ///< δ_u
 };
 
 struct McCounts {
-  std::array<std::int64_t, 4> tried{}, accepted{};  ///< crank, twist, tilt, shift
+  std::array<std::int64_t, 6> tried{}, accepted{};  ///< crank, twist, tilt, shift, spin, dilate
   std::int64_t lk_checks = 0;                       ///< exact Lk evaluations
   std::int64_t lk_rejects = 0;                      ///< moves rejected for changing Lk
 };
@@ -112,8 +121,11 @@ class RingMC {
   const McSteps& steps() const { return steps_; }
   double link0() const { return lk0_; }
   void reset_counts() { counts_ = {}; }
+  bool debug_ = false;  ///< check the running energies against full sums after every move
   /// largest discrepancy seen between the incrementally updated pair energy and the full sum
   double max_pair_drift() const { return max_pair_drift_; }
+  /// largest max |DᵀD − I| of a triad at a sweep's end (before it is re-orthonormalised)
+  double max_triad_drift() const { return max_triad_drift_; }
 
  private:
   bool accept(double dE);
@@ -121,6 +133,8 @@ class RingMC {
   bool twist_move();
   bool tilt_move();
   bool shift_move();
+  bool spin_move();
+  bool dilate_move();
   /// whether the position move just made may have changed Lk, and if it has (restores nothing)
   bool link_changed(double max_path, double e_steric);
 
@@ -131,7 +145,8 @@ class RingMC {
   McCounts counts_;
   std::vector<int> moved_;
   std::vector<char> is_moved_;
-  double max_pair_drift_ = 0;  ///< largest |running pair energy − pairs()| at a sweep's end, kT
+  double max_pair_drift_ = 0;
+  double max_triad_drift_ = 0;  ///< largest |running pair energy − pairs()| at a sweep's end, kT
   double e_el_ = 0, e_pair_ = 0;  ///< current elastic and pair energies, kT
   double e_steric_ = 0;           ///< its steric part, kT (contacts closer than D: > 0)
   double lk0_ = 0;
