@@ -60,7 +60,8 @@ struct Config {
   double rod_intrinsic_twist_per_A = 0.0;           ///< Ω³₀, rad/Å
   std::vector<double> rod_intrinsic_curvature_per_A{0.0, 0.0};  ///< Ω¹₀, Ω²₀, rad/Å
   std::string
-      rod_initial_shape;   ///< rod.initial_shape: "" (the twisted circle) or a file (io/rod_shape)
+      rod_initial_shape;  ///< rod.initial_shape: "" (the twisted circle) or a file (io/rod_shape)
+  std::string rod_intrinsic_file;  ///< rod.intrinsic_file: "" or a CSV of per-link Ω¹₀, Ω²₀, Ω³₀
   bool rod_closed = true;  ///< rod.closed: a closed ring, or an open rod with free ends
   // [solvent]
   double solvent_salt_M = 0.1;  ///< Cs, mol/L
@@ -133,6 +134,11 @@ bool only_end_time_extended(const std::string& old_toml, const Config& now,
 
 /// Convert to internal units (g, Å, s) for the simulation.
 sim::SimParams to_params(const Config& c);
+
+/// rod.intrinsic_file: the per-link intrinsic strains (Ω¹₀, Ω²₀, Ω³₀ per row, rad/Å; '#' lines
+/// and blank lines skipped), exactly n rows of 3 finite numbers; empty for path "". Throws
+/// ConfigError naming the key, the file and the offending line or count.
+std::vector<Vec3> read_intrinsic_file(const std::string& path, int n);
 
 /// What `ibrod check` warns of (the run is allowed): a grid spacing larger than the hard core,
 /// a time step above the scheme's measured stability limit, a box that leaves the ring's periodic

@@ -1,5 +1,7 @@
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -118,6 +120,44 @@ void validate(const Config& c) {
             " >= 1)");
 }
 
+std::vector<Vec3> read_intrinsic_file(const std::string& path, int n) {
+  std::vector<Vec3> out;
+  if (path.empty()) return out;
+  const std::string key = "rod.intrinsic_file";
+  std::ifstream in(path);
+  if (!in) bad(key, path, "a readable file (cannot open it)");
+  std::string line;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const auto first = line.find_first_not_of(" \t");
+    if (first == std::string::npos || line[first] == '#') continue;  // blank lines, comments
+    std::stringstream row(line);
+    std::string cell;
+    std::vector<double> v;
+    bool ok = true;
+    while (std::getline(row, cell, ',')) {
+      char* end = nullptr;
+      const double x = std::strtod(cell.c_str(), &end);
+      while (end && (*end == ' ' || *end == '\t')) ++end;
+      if (end == cell.c_str() || !end || *end != '\0' || !std::isfinite(x)) ok = false;
+      v.push_back(x);
+    }
+    if (!ok || v.size() != 3)
+      bad(key, path,
+          "rows of 3 finite numbers Ω¹₀, Ω²₀, Ω³₀ (rad/Å) separated by commas ('#' lines are "
+          "comments), but line " +
+              std::to_string(line_no) + " is \"" + detail::echo(line) + "\"");
+    out.emplace_back(v[0], v[1], v[2]);
+  }
+  if (int(out.size()) != n)
+    bad(key, path,
+        "one row per rod point, rod.base_pairs = " + std::to_string(n) + " rows, but it has " +
+            std::to_string(out.size()));
+  return out;
+}
+
 sim::SimParams to_params(const Config& c) {
   using namespace units;
   sim::SimParams p;
@@ -138,6 +178,14 @@ sim::SimParams to_params(const Config& c) {
   s.rod.b = Vec3(b, b, c.rod_stretch_modulus_dyn * dyn);
   s.rod.omega0 = Vec3(c.rod_intrinsic_curvature_per_A[0], c.rod_intrinsic_curvature_per_A[1],
                       c.rod_intrinsic_twist_per_A);
+  s.rod.omega0_k = read_intrinsic_file(c.rod_intrinsic_file, c.rod_base_pairs);
+  for (std::size_t k = 0; k < s.rod.omega0_k.size(); ++k)  // the scalar keys' bound, per row
+    if (s.rod.omega0_k[k].cwiseAbs().maxCoeff() * c.rod_rise_A > kMaxTwistPerSegment)
+      bad("rod.intrinsic_file", c.rod_intrinsic_file,
+          "|Ω¹₀|, |Ω²₀|, |Ω³₀| <= π / (2 rod.rise_A) = " + fmt(kMaxTwistPerSegment / c.rod_rise_A) +
+              " rad/Å in every row (a bend or twist of at most π/2 between neighbouring "
+              "triads), but row " +
+              std::to_string(k + 1) + " exceeds it");
   s.rod.closed = c.rod_closed;
   p.kT = kT(c.solvent_temperature_K);
   // MODEL (2.19–2.22): A = q²/(4π ε0 εw), κ = 0.329 √Cs

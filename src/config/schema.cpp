@@ -227,6 +227,26 @@ Key intrinsic_curvature_key() {
   return k;
 }
 
+// rod.intrinsic_file: a file name (a string key; "" for none); read by to_params
+Key intrinsic_file_key() {
+  Key k;
+  k.name = "rod.intrinsic_file";
+  k.help =
+      "per-link intrinsic curvatures and twist: a CSV with one row per rod point, Ω¹₀, Ω²₀, Ω³₀ "
+      "in rad/Å (row k: link k → k+1); replaces rod.intrinsic_curvature_per_A and "
+      "rod.intrinsic_twist_per_A; \"\": those keys";
+  k.set = [](Config& c, const toml::node& n) {
+    const auto v = n.value_exact<std::string>();
+    if (!v) bad("rod.intrinsic_file", show(n), "a file name in quotes, or \"\" for none");
+    c.rod_intrinsic_file = *v;
+  };
+  k.put = [](const Config& c, toml::table& t) {
+    t.insert_or_assign("intrinsic_file", c.rod_intrinsic_file);
+  };
+  k.value = [](const Config& c) { return "\"" + c.rod_intrinsic_file + "\""; };
+  return k;
+}
+
 // rod.initial_shape: a file name (a string key; "" for none)
 Key initial_shape_key() {
   Key k;
@@ -372,6 +392,7 @@ const std::vector<Key>& schema() {
       real("rod.intrinsic_twist_per_A", &Config::rod_intrinsic_twist_per_A, -inf, false, inf,
            "intrinsic twist Ω³₀, rad/Å (0: untwisted reference)"),
       intrinsic_curvature_key(),
+      intrinsic_file_key(),
       initial_shape_key(),
       boolean("rod.closed", &Config::rod_closed,
               "true: a closed ring; false: an open rod with two free ends, straight along x "

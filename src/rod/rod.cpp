@@ -33,8 +33,8 @@ struct HalfPoint {
   Vec3 E;   ///< (bend, twist, stretch) share of E_h from this half point, g Å² s⁻²
 };
 
-inline HalfPoint eval_half(const RodParams& p, const Vec3& Xk, const Vec3& Xk1, const Mat3& Dk,
-                           const Mat3& Dk1) {
+inline HalfPoint eval_half(const RodParams& p, int k, const Vec3& Xk, const Vec3& Xk1,
+                           const Mat3& Dk, const Mat3& Dk1) {
   const double inv_ds = 1.0 / p.ds;
   HalfPoint h;
   h.Dh = half_triad(Dk, Dk1);
@@ -45,7 +45,7 @@ inline HalfPoint eval_half(const RodParams& p, const Vec3& Xk, const Vec3& Xk1, 
   h.Xp = (Xk1 - Xk) * inv_ds;
   Vec3 gamma = h.Dh.transpose() * h.Xp;  // Γᵢ = Dⁱ·X′ − δᵢ₃
   gamma.z() -= 1.0;
-  const Vec3 dom = omega - p.omega0;
+  const Vec3 dom = omega - (p.omega0_k.empty() ? p.omega0 : p.omega0_k[k]);
   // Constitutive laws MODEL (2.5–2.8): body components, then to the lab frame.
   const Vec3 Nb = p.a.cwiseProduct(dom);
   const Vec3 Fb = p.b.cwiseProduct(gamma);
@@ -74,6 +74,7 @@ ElasticEnergy elastic_forces(const RodParams& p, const RodState& s, RodWork& w, 
   check_size(s.D.size(), n, "D");
   check_size(F.size(), n, "F");
   check_size(T.size(), n, "T");
+  if (!p.omega0_k.empty()) check_size(p.omega0_k.size(), n, "omega0_k");
   if (w.Dh.size() != std::size_t(n) || w.Fh.size() != std::size_t(n) ||
       w.Nh.size() != std::size_t(n) || w.Xp.size() != std::size_t(n) ||
       w.Eh.size() != std::size_t(n))
@@ -87,7 +88,7 @@ ElasticEnergy elastic_forces(const RodParams& p, const RodState& s, RodWork& w, 
     {
 #pragma omp for schedule(static)
       for (int k = 0; k < m; ++k) {
-        const HalfPoint h = eval_half(p, s.X[k], s.X[k + 1], s.D[k], s.D[k + 1]);
+        const HalfPoint h = eval_half(p, k, s.X[k], s.X[k + 1], s.D[k], s.D[k + 1]);
         w.Dh[k] = h.Dh;
         w.Xp[k] = h.Xp;
         w.Fh[k] = h.Fh;
@@ -122,7 +123,7 @@ ElasticEnergy elastic_forces(const RodParams& p, const RodState& s, RodWork& w, 
 #pragma omp for schedule(static)
     for (int k = 0; k < n; ++k) {
       const int k1 = (k + 1 == n) ? 0 : k + 1;
-      const HalfPoint h = eval_half(p, s.X[k], s.X[k1], s.D[k], s.D[k1]);
+      const HalfPoint h = eval_half(p, k, s.X[k], s.X[k1], s.D[k], s.D[k1]);
       w.Dh[k] = h.Dh;
       w.Xp[k] = h.Xp;
       w.Fh[k] = h.Fh;
@@ -148,10 +149,11 @@ ElasticEnergy elastic_forces(const RodParams& p, const RodState& s, RodWork& w, 
 ElasticEnergy elastic_energy(const RodParams& p, const RodState& s) {
   const int n = s.size();
   check_size(s.D.size(), n, "D");
+  if (!p.omega0_k.empty()) check_size(p.omega0_k.size(), n, "omega0_k");
   Vec3 e = Vec3::Zero();
   for (int k = 0; k < half_points(n, p.closed); ++k) {
     const int k1 = (k + 1 == n) ? 0 : k + 1;
-    e += eval_half(p, s.X[k], s.X[k1], s.D[k], s.D[k1]).E;
+    e += eval_half(p, k, s.X[k], s.X[k1], s.D[k], s.D[k1]).E;
   }
   return {e.x(), e.y(), e.z()};
 }

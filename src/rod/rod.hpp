@@ -20,7 +20,10 @@ struct RodParams {
   Vec3 a{1.3e5, 1.3e5, 1.82e5};  ///< a1, a2 (bending), a3 (twist), g Å³ s⁻²
   Vec3 b{5e3, 5e3, 5e3};         ///< b1, b2 (shear), b3 (stretch), g Å s⁻²
   Vec3 omega0{0.0, 0.0, 0.0};  ///< intrinsic curvatures Ω¹₀, Ω²₀ and twist Ω³₀, Å⁻¹
-  bool closed = true;          ///< closed ring (X_n = X_0) or open rod with two free ends
+  /// Per link: omega0_k[k] replaces omega0 at half point k+½ (link k → k+1) when not empty; size
+  /// n (an open rod uses the first n − 1). rod.intrinsic_file (docs/config.md).
+  std::vector<Vec3> omega0_k;
+  bool closed = true;  ///< closed ring (X_n = X_0) or open rod with two free ends
 };
 
 /// Number of half points (links k → k+1) of a rod of n points: n closed, n − 1 open.
