@@ -81,20 +81,33 @@ ElasticEnergy elastic_forces(const RodParams& p, const RodState& s, RodWork& w, 
     w.resize(n);  // allocates once; every later call with the same n reuses it
   const double half_ds = 0.5 * p.ds;
 
-  if (!p.closed) {
-    // Open rod: half points 0 … n−2; the ends have no half point beyond them (free ends).
-    const int m = half_points(n, false);
+  // Half points k+½ between k and k+1: n of them on a closed rod (cyclic), n − 1 on an open one
+  // (its ends have no half point beyond them: free ends). One parallel region, two loops; below a
+  // few hundred points the fork/join costs more than the work (at n = 600 one thread took 50 µs,
+  // two 36 µs).
+  const int m = half_points(n, p.closed);
 #pragma omp parallel if (n >= 256)
-    {
+  {
 #pragma omp for schedule(static)
-      for (int k = 0; k < m; ++k) {
-        const HalfPoint h = eval_half(p, k, s.X[k], s.X[k + 1], s.D[k], s.D[k + 1]);
-        w.Dh[k] = h.Dh;
-        w.Xp[k] = h.Xp;
-        w.Fh[k] = h.Fh;
-        w.Nh[k] = h.Nh;
-        w.Eh[k] = h.E;
+    for (int k = 0; k < m; ++k) {
+      const int k1 = (k + 1 == n) ? 0 : k + 1;
+      const HalfPoint h = eval_half(p, k, s.X[k], s.X[k1], s.D[k], s.D[k1]);
+      w.Dh[k] = h.Dh;
+      w.Xp[k] = h.Xp;
+      w.Fh[k] = h.Fh;
+      w.Nh[k] = h.Nh;
+      w.Eh[k] = h.E;
+    }
+    // Nodes: Δs f_k and Δs n_k of MODEL §4 step 4 (the implicit barrier above orders the loops;
+    // every thread takes the same branch).
+    if (p.closed) {
+#pragma omp for schedule(static)
+      for (int k = 0; k < n; ++k) {
+        const int km = (k == 0) ? n - 1 : k - 1;
+        F[k] += w.Fh[k] - w.Fh[km];
+        T[k] += w.Nh[k] - w.Nh[km] + half_ds * (w.Xp[k].cross(w.Fh[k]) + w.Xp[km].cross(w.Fh[km]));
       }
+    } else {
 #pragma omp for schedule(static)
       for (int k = 0; k < n; ++k) {
         Vec3 f = Vec3::Zero(), t = Vec3::Zero();
@@ -110,39 +123,12 @@ ElasticEnergy elastic_forces(const RodParams& p, const RodState& s, RodWork& w, 
         T[k] += t;
       }
     }
-    Vec3 e = Vec3::Zero();
-    for (int k = 0; k < m; ++k) e += w.Eh[k];
-    return {e.x(), e.y(), e.z()};
-  }
-
-  // One parallel region, two loops; below a few hundred points the fork/join costs more than the
-  // work (at n = 600 one thread took 50 µs, two 36 µs).
-#pragma omp parallel if (n >= 256)
-  {
-    // Half points k+½ between k and k+1 (cyclic).
-#pragma omp for schedule(static)
-    for (int k = 0; k < n; ++k) {
-      const int k1 = (k + 1 == n) ? 0 : k + 1;
-      const HalfPoint h = eval_half(p, k, s.X[k], s.X[k1], s.D[k], s.D[k1]);
-      w.Dh[k] = h.Dh;
-      w.Xp[k] = h.Xp;
-      w.Fh[k] = h.Fh;
-      w.Nh[k] = h.Nh;
-      w.Eh[k] = h.E;
-    }
-    // Nodes: Δs f_k and Δs n_k of MODEL §4 step 4 (the implicit barrier above orders the loops).
-#pragma omp for schedule(static)
-    for (int k = 0; k < n; ++k) {
-      const int km = (k == 0) ? n - 1 : k - 1;
-      F[k] += w.Fh[k] - w.Fh[km];
-      T[k] += w.Nh[k] - w.Nh[km] + half_ds * (w.Xp[k].cross(w.Fh[k]) + w.Xp[km].cross(w.Fh[km]));
-    }
   }
 
   // Serial sum in index order: the energy does not depend on the thread count, and equals
   // elastic_energy() bit for bit.
   Vec3 e = Vec3::Zero();
-  for (int k = 0; k < n; ++k) e += w.Eh[k];
+  for (int k = 0; k < m; ++k) e += w.Eh[k];
   return {e.x(), e.y(), e.z()};
 }
 
