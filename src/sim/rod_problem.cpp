@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <vector>
+
+#include "rod/rod_set.hpp"
 
 namespace ibrod::sim {
 
@@ -59,6 +62,50 @@ std::string state_problem(const rod::RodState& s, int n, double ds, bool closed)
                     det);
       return buf;
     }
+  return {};
+}
+
+namespace {
+int total_points(std::span<const rod::RodParams> rods) {
+  int n = 0;
+  for (const rod::RodParams& r : rods) n += r.n;
+  return n;
+}
+}  // namespace
+
+std::string rods_problem(std::span<const rod::RodParams> rods, const rod::RodState& s,
+                         double thermal_kT) {
+  if (rods.size() == 1)
+    return rod_problem(s, rods[0].ds, spacing_tolerance(rods[0], thermal_kT), rods[0].closed);
+  const int n = total_points(rods);
+  if (s.size() != n || int(s.D.size()) != n)
+    return std::to_string(s.size()) + " positions and " + std::to_string(s.D.size()) +
+           " triads; the rods have " + std::to_string(n) + " points";
+  rod::RodState one;
+  const std::vector<rod::RodRange> ranges = rod::ranges_of(rods);
+  for (std::size_t r = 0; r < rods.size(); ++r) {
+    rod::extract(s, ranges[r], one);
+    if (std::string bad = rod_problem(one, rods[r].ds, spacing_tolerance(rods[r], thermal_kT),
+                                      rods[r].closed);
+        !bad.empty())
+      return "rod " + std::to_string(r) + ": " + bad;
+  }
+  return {};
+}
+
+std::string rods_state_problem(std::span<const rod::RodParams> rods, const rod::RodState& s) {
+  if (rods.size() == 1) return state_problem(s, rods[0].n, rods[0].ds, rods[0].closed);
+  const int n = total_points(rods);
+  if (s.size() != n || int(s.D.size()) != n)
+    return std::to_string(s.size()) + " positions and " + std::to_string(s.D.size()) +
+           " triads; the rods have " + std::to_string(n) + " points together";
+  rod::RodState one;
+  const std::vector<rod::RodRange> ranges = rod::ranges_of(rods);
+  for (std::size_t r = 0; r < rods.size(); ++r) {
+    rod::extract(s, ranges[r], one);
+    if (std::string bad = state_problem(one, rods[r].n, rods[r].ds, rods[r].closed); !bad.empty())
+      return "rod " + std::to_string(r) + ": " + bad;
+  }
   return {};
 }
 
