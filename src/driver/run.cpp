@@ -105,6 +105,9 @@ void Run::State::build_simulation() {
     sim->set_rod_state(std::move(whole), "rod.initial_shape");
     rod_shapes.clear();
   }
+  if (sim->rods().size() > 1 && !checkpoint)
+    if (const std::string bad = sim->start_problem(); !bad.empty())
+      throw ConfigError("[[rods]]: the initial state: " + bad);
   // distributed: rank 0 holds every rank's plans (fftw_mpi_gather_wisdom)
   on_disk([&] {
     const std::string wisdom = fluid::wisdom_text();
@@ -318,20 +321,27 @@ void Run::State::check_link(const sim::Observables& o) {
         any = true;
         drift = std::max(drift, std::abs(o.rods[r].link - result.initial.rods[r].link));
       }
+    // and each pair's linking number: one rod passing through another changes it
+    for (std::size_t q = 0; q < o.pair_links.size() && q < result.initial.pair_links.size(); ++q) {
+      any = true;
+      drift = std::max(drift, std::abs(o.pair_links[q] - result.initial.pair_links[q]));
+    }
     if (!any) return;
   }
   meta.max_link_drift = std::max(meta.max_link_drift, drift);
   if (drift > kLinkDriftWarning && !meta.self_passage_warning) {
     meta.self_passage_warning = true;
     meta.self_passage_step = o.step;
-    char buf[320];
+    char buf[420];
     std::snprintf(buf, sizeof buf,
                   "ibrod: warning: at step %lld the linking number Lk = %.4f drifted by %.3g from "
-                  "its initial %.4f (more than %.1f): the rod has probably passed through "
-                  "itself (steric.stiffness or steric.diameter_A too small, or Δt too large); "
-                  "recorded in summary.json",
+                  "its initial %.4f (more than %.1f): %s (steric.stiffness or steric.diameter_A "
+                  "too small, or Δt too large); recorded in summary.json",
                   static_cast<long long>(o.step), o.link, o.link - result.initial.link,
-                  result.initial.link, kLinkDriftWarning);
+                  result.initial.link, kLinkDriftWarning,
+                  o.rods.empty() ? "the rod has probably passed through itself"
+                                 : "a rod has probably passed through itself or another rod "
+                                   "(rods.csv: each rod's link and each pair's)");
     say(buf);
   }
 }

@@ -56,7 +56,9 @@ class RunFiles {
     const int n = sim.rod().size();
     for (const rod::RodParams& r : sim.rods()) rod_ds_.push_back(r.ds);
     const bool several = sim.rods().size() > 1;
-    const std::string rods_header = io::rods_header(int(sim.rods().size()));
+    std::vector<bool> closed;
+    for (const rod::RodParams& r : sim.rods()) closed.push_back(r.closed);
+    const std::string rods_header = io::rods_header(closed);
     if (resume_step < 0) {
       io::write_file_atomic(ts, io::timeseries_header() + "\n");
       if (several) io::write_file_atomic(dir.rods(), rods_header + "\n");

@@ -118,12 +118,16 @@ std::string final_state_csv(const rod::RodState& s, const std::vector<rod::RodRa
   return out;
 }
 
-std::string rods_header(int rods) {
+std::string rods_header(const std::vector<bool>& closed) {
   std::string s = "step,time_us";
-  for (int r = 0; r < rods; ++r) {
+  const std::size_t rods = closed.size();
+  for (std::size_t r = 0; r < rods; ++r) {
     const std::string k = std::to_string(r);
     s += ",writhe_" + k + ",twist_" + k + ",link_" + k;
   }
+  for (std::size_t a = 0; a < rods; ++a)
+    for (std::size_t b = a + 1; b < rods; ++b)
+      if (closed[a] && closed[b]) s += ",link_" + std::to_string(a) + "_" + std::to_string(b);
   return s;
 }
 
@@ -140,6 +144,10 @@ std::string rods_row(const sim::Observables& o) {
       std::snprintf(buf, sizeof buf, ",%.12g", v);
       s += buf;
     }
+  for (double v : o.pair_links) {
+    std::snprintf(buf, sizeof buf, ",%.12g", v);
+    s += buf;
+  }
   return s;
 }
 

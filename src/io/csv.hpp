@@ -43,8 +43,9 @@ std::string final_state_csv(const rod::RodState& s);
 std::string final_state_csv(const rod::RodState& s, const std::vector<rod::RodRange>& ranges);
 
 /// rods.csv of a run of several rods (docs/outputs.md): step,time_us, then writhe_r,twist_r,link_r
-/// for r = 0 … rods − 1 (an open rod's writhe and link empty).
-std::string rods_header(int rods);
+/// for r = 0 … rods − 1 (an open rod's writhe and link empty), then link_a_b, the linking number of
+/// each pair a < b of closed rods (`closed`: each rod's).
+std::string rods_header(const std::vector<bool>& closed);
 /// One row of rods.csv from a time-series row (Observables::rods), no newline.
 std::string rods_row(const sim::Observables& o);
 

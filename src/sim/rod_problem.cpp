@@ -106,6 +106,24 @@ std::string rods_state_problem(std::span<const rod::RodParams> rods, const rod::
     if (std::string bad = state_problem(one, rods[r].n, rods[r].ds, rods[r].closed); !bad.empty())
       return "rod " + std::to_string(r) + ": " + bad;
   }
+  // two rods must not start on top of each other (coincident charges, crossed hard cores)
+  for (std::size_t a = 0; a < rods.size(); ++a)
+    for (std::size_t b = a + 1; b < rods.size(); ++b) {
+      const double min_d = 0.5 * std::min(rods[a].ds, rods[b].ds);
+      for (int i = 0; i < ranges[a].n; ++i)
+        for (int j = 0; j < ranges[b].n; ++j) {
+          const double d = (s.X[ranges[a].offset + i] - s.X[ranges[b].offset + j]).norm();
+          if (!(d >= min_d)) {
+            char buf[256];
+            std::snprintf(buf, sizeof buf,
+                          "rods %zu and %zu overlap: point %d of rod %zu and point %d of rod %zu "
+                          "are %.3g Å apart (at least half a rise, %.3g Å, needed; place the rods "
+                          "apart with rod.offset_A)",
+                          a, b, i, a, j, b, d, min_d);
+            return buf;
+          }
+        }
+    }
   return {};
 }
 

@@ -124,7 +124,17 @@ Simulation::Simulation(const SimParams& p)
   // MODEL §6: the electrostatic energy is also reported relative to the circle at the same salt.
   // The unperturbed circle (perturbation only rotates triads, so X is the same); for an open rod
   // the straight rod.
-  if (p_.stepper.electro.enabled) electro_circle_ = stepper_.electrostatics().energy(rod_.X);
+  // Several rods: the sum of each rod's own shape alone (rods placed anywhere, even on top of
+  // each other before rod.initial_shape moves them, give the same reference).
+  if (p_.stepper.electro.enabled && rods_.size() == 1)
+    electro_circle_ = stepper_.electrostatics().energy(rod_.X);
+  if (p_.stepper.electro.enabled && rods_.size() > 1) {
+    rod::RodState one;
+    for (const rod::RodRange& g : ranges_) {
+      rod::extract(rod_, g, one);
+      electro_circle_ += interactions::Electrostatics(p_.stepper.electro, g.n).energy(one.X);
+    }
+  }
   if (p_.scheme == TimeScheme::implicit_step)
     implicit_ = std::make_unique<integrate::ImplicitIntegrator>(stepper_, p_.implicit, p_.adaptive);
 }
@@ -134,6 +144,8 @@ void Simulation::set_t_end(double t_end) {
     throw std::invalid_argument("Simulation: t_end must be positive and finite");
   p_.t_end = t_end;
 }
+
+std::string Simulation::start_problem() const { return rods_state_problem(rods_, rod_); }
 
 std::string Simulation::state_check() const {
   return rods_problem(rods_, rod_, p_.stepper.fluid.thermal_kT);
@@ -288,6 +300,12 @@ Observables Simulation::observe() {
               closest, (rod_.X[ranges_[a].offset + i] - rod_.X[ranges_[b].offset + j]).norm());
   o.closest_approach_A = closest;
   o.bp_spacing_A = links > 0 ? spacing / links : 0.0;
+  for (std::size_t a = 0; a < rods_.size(); ++a)
+    for (std::size_t b = a + 1; b < rods_.size(); ++b)
+      if (rods_[a].closed && rods_[b].closed)
+        o.pair_links.push_back(diagnostics::linking_number(
+            std::span<const Vec3>(rod_.X).subspan(ranges_[a].offset, ranges_[a].n),
+            std::span<const Vec3>(rod_.X).subspan(ranges_[b].offset, ranges_[b].n)));
   return o;
 }
 

@@ -82,6 +82,10 @@ struct Observables {
     double writhe = 0, twist = 0, link = 0;
   };
   std::vector<PerRod> rods;
+  /// Several rods: the Gauss linking number of each pair a < b of closed rods, in the order
+  /// (0,1), (0,2), …, (1,2), …; a topological invariant like each rod's link (a passage of one
+  /// rod through another changes it). Empty for one rod.
+  std::vector<double> pair_links;
 };
 
 /// Why a run stopped (summary.json's stop_reason, the checkpoint's): none while it runs.
@@ -108,6 +112,10 @@ class Simulation {
   /// What is wrong with the state, "" if nothing (sim::rods_problem: each rod's spacing, triads,
   /// finiteness; the spacing tolerance widened for thermal noise).
   std::string state_check() const;
+  /// What is wrong with the state as a start, "" if nothing: sim::rods_state_problem (each rod's
+  /// count, spacing, triads, handedness; with several rods also two rods closer than half a rise,
+  /// O(n²)). The driver asks before the first step.
+  std::string start_problem() const;
   const rod::RodState& rod() const { return rod_; }
   rod::RodState& rod() { return rod_; }
   integrate::Stepper& stepper() { return stepper_; }
