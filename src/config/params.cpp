@@ -381,8 +381,11 @@ double stable_dt_limit_ns(const Config& c) {
   // but not 1.3 ns with c = h = 725/32 Å: the limit grows as c². The implicit scheme is stable
   // to 20× the explicit limit (4.4 ns at the reference).
   // A rod stiffer than MODEL §1's lowers it as 1/stiffness (the explicit update of a stiff spring
-  // is stable for Δt < 2/(mobility × stiffness)): the largest modulus of each kind (per link with
-  // rod.moduli_file) against its reference; a softer rod keeps the measured limit.
+  // is stable for Δt < 2/(mobility × stiffness)), each modulus taken per link with
+  // rod.moduli_file (the stiffest link). Measured at c = 725/32 Å (docs/config.md): the shear and
+  // stretch set the limit (b1 or b3 doubled: unstable at 0.9 and 0.6 ns, stable at 0.45), the
+  // bending and twist only beyond 4× (a1, a3 ×4: stable at 0.9 ns; ×8: unstable), so the factor
+  // is max(1, b/b_ref, a/(4 a_ref)); a softer rod keeps the measured limit.
   const double c_ref = 725.0 / 64, c_A = c.grid_kernel_width * c.grid_box_A / c.grid_n;
   Vec3 a_max(c.rod_bend_modulus_erg_cm, c.rod_bend_modulus_erg_cm, c.rod_twist_modulus_erg_cm);
   Vec3 b_max(c.rod_shear_modulus_dyn, c.rod_shear_modulus_dyn, c.rod_stretch_modulus_dyn);
@@ -395,8 +398,8 @@ double stable_dt_limit_ns(const Config& c) {
     }
   }
   const double stiffer =
-      std::max({1.0, a_max.x() / 1.3e-19, a_max.y() / 1.3e-19, a_max.z() / 1.82e-19,
-                b_max.x() / 5e-5, b_max.y() / 5e-5, b_max.z() / 5e-5});
+      std::max({1.0, b_max.x() / 5e-5, b_max.y() / 5e-5, b_max.z() / 5e-5,
+                a_max.x() / (4 * 1.3e-19), a_max.y() / (4 * 1.3e-19), a_max.z() / (4 * 1.82e-19)});
   const double explicit_limit = 0.22 * (c_A / c_ref) * (c_A / c_ref) / stiffer;
   return c.time_scheme == "implicit" ? 20 * explicit_limit : explicit_limit;
 }

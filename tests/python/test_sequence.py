@@ -2,17 +2,18 @@
 per-dinucleotide table (ILLUSTRATIVE values) become rod.intrinsic_file and rod.moduli_file
 (examples/sequence/sequence_rod.py), and runs reach the closed forms.
 
-- poly(A), 60 bp, open (examples/sequence/polyA.toml, run for 0.3 µs instead of 0.6): every step
+- poly(A), 60 bp, open (examples/sequence/polyA.toml, run for 0.4 µs instead of 0.6): every step
   alike, so the relaxed rod is the helix of curvature |roll|/Δs and torsion twist/Δs — radius
   κ/(κ² + τ²) = 0.308 Å, pitch 33.80 Å for the discrete rod (34.37 Å continuous). Measured at
-  0.3 µs (32³): radius +8.4 %, pitch +1.0 %, 0.13 Å rms from the stress-free shape built by
-  sequence_rod.stress_free_shape, E_total 1761 → 0.32 kT; at 0.6 µs +1.2 %, +0.3 %, 0.044 Å.
-  Tolerances: 15 % on the radius, 2 % on the pitch, 0.3 Å rms, E down by more than 99.9 %.
+  0.4 µs (32³, 250 Å box): radius +7.9 % (0.024 Å), pitch +1.0 %, 0.13 Å rms from the stress-free
+  shape built by sequence_rod.stress_free_shape, E_total 1761.3 → 0.187 kT (at 0.3 µs: +18 %,
+  +1.9 %, 0.20 Å; at 0.6 µs +1.6 %, +0.3 %, 0.056 Å: the short wobble relaxes last). Tolerances:
+  15 % on the radius, 2 % on the pitch, 0.3 Å rms, E down by more than 99.9 %.
 - (A25 G25)2 ring, 100 bp, moduli only (examples/sequence/ring_a25g25.toml, 0.3 µs instead of
   0.5): the stiffer AA steps bend less, a1 · 2 sin(θ/2) = M Δs on every link. Measured at 0.3 µs:
   θ(AA) +0.4 %, θ(GG) −0.2 % from the closed form inside the blocks (5 links from either
   junction left out: the junctions are still relaxing), ratio 0.671, E_bend 21.730 kT against
-  21.685 (+0.2 %). The whole file: about 20 s.
+  21.685 (+0.2 %). The whole file: 10 s on an idle 2-core machine, 35 s on a busy one.
   Tolerances: 4 % on the block means, 1 % on E_bend, θ(AA)/θ(GG) below 0.72 (1/1.5 = 0.667).
 
 Also: the committed files are what the script makes of the sequences, and the conversion keeps
@@ -82,7 +83,7 @@ def test_reference_twist_only_turns_the_frame():
 def test_poly_a_relaxes_to_its_helix(binary, tmp_path):
     out = tmp_path / "polyA"
     r = run_cli(binary, ["run", os.path.join(SEQ, "polyA.toml"), "-o", str(out),
-                         "--set", "time.t_end_us=0.3", "--set", "run.threads=2",
+                         "--set", "time.t_end_us=0.4", "--set", "run.threads=2",
                          "--set", "run.fftw_measure=false"], cwd=ROOT)
     assert r.returncode == 0, r.stderr
     X, _ = read_state(str(out))
