@@ -5,6 +5,7 @@
 // values throw ConfigError naming the key, the value and what is allowed.
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "rod/perturbation.hpp"
@@ -62,7 +63,8 @@ struct Config {
   std::string
       rod_initial_shape;  ///< rod.initial_shape: "" (the twisted circle) or a file (io/rod_shape)
   std::string rod_intrinsic_file;  ///< rod.intrinsic_file: "" or a CSV of per-link Ω¹₀, Ω²₀, Ω³₀
-  bool rod_closed = true;  ///< rod.closed: a closed ring, or an open rod with free ends
+  std::string rod_moduli_file;  ///< rod.moduli_file: "" or a CSV of per-link a1 a2 a3, b1 b2 b3
+  bool rod_closed = true;       ///< rod.closed: a closed ring, or an open rod with free ends
   std::vector<double> rod_rotation_deg{0.0, 0.0, 0.0};  ///< rod.rotation_deg: about x, y, z, °
   std::vector<double> rod_offset_A{0.0, 0.0, 0.0};      ///< rod.offset_A: centre − box centre, Å
   /// [[rods]] (docs/config.md "Several rods"): one table per rod, each a list of (rod key without
@@ -155,6 +157,12 @@ sim::SimParams to_params(const Config& c);
 /// and blank lines skipped), exactly n rows of 3 finite numbers; empty for path "". Throws
 /// ConfigError naming the key, the file and the offending line or count.
 std::vector<Vec3> read_intrinsic_file(const std::string& path, int n);
+
+/// rod.moduli_file: the per-link moduli, exactly n rows of 6 finite numbers > 0 (a1, a2, a3 in
+/// erg·cm, b1, b2, b3 in dyn; '#' lines and blank lines skipped), converted to internal units:
+/// {a_k, b_k} (g Å³ s⁻², g Å s⁻²); both empty for path "". Throws ConfigError naming the key, the
+/// file and the offending line or count.
+std::pair<std::vector<Vec3>, std::vector<Vec3>> read_moduli_file(const std::string& path, int n);
 
 /// What `ibrod check` warns of (the run is allowed): a grid spacing larger than the hard core,
 /// a time step above the scheme's measured stability limit, a box that leaves the ring's periodic

@@ -2,8 +2,10 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "config/config.hpp"
@@ -139,7 +141,8 @@ void validate_one(const Config& c) {
   const double a3 = c.rod_twist_modulus_erg_cm * units::erg_cm;
   const double b = c.rod_shear_modulus_dyn * units::dyn;
   const double sin_beta = rod::circle_tilt_sin_beta(a, a3, b, r0, c.rod_excess_link);
-  if (c.rod_closed && !(std::abs(sin_beta) < 1))
+  // (with rod.moduli_file, to_params checks it at the file's mean moduli)
+  if (c.rod_closed && c.rod_moduli_file.empty() && !(std::abs(sin_beta) < 1))
     bad("rod.excess_link", std::to_string(c.rod_excess_link),
         "a link small enough that the twisted circle exists (|sin β| = " + fmt(std::abs(sin_beta)) +
             " >= 1)");
@@ -155,10 +158,16 @@ void validate_one(const Config& c) {
 }
 }  // namespace
 
-std::vector<Vec3> read_intrinsic_file(const std::string& path, int n) {
-  std::vector<Vec3> out;
-  if (path.empty()) return out;
-  const std::string key = "rod.intrinsic_file";
+namespace {
+
+// Rows of `cols` comma-separated finite numbers, one per rod point ('#' lines and blank lines
+// skipped); `what` says what a row holds in the messages; row_problem(v) says what is wrong with a
+// row of numbers ("" if nothing).
+std::vector<std::vector<double>> read_rows(
+    const std::string& key, const std::string& path, int n, std::size_t cols,
+    const std::string& what,
+    const std::function<std::string(const std::vector<double>&)>& row_problem) {
+  std::vector<std::vector<double>> out;
   std::ifstream in(path);
   if (!in) bad(key, path, "a readable file (cannot open it)");
   std::string line;
@@ -179,17 +188,52 @@ std::vector<Vec3> read_intrinsic_file(const std::string& path, int n) {
       if (end == cell.c_str() || !end || *end != '\0' || !std::isfinite(x)) ok = false;
       v.push_back(x);
     }
-    if (!ok || v.size() != 3)
+    const std::string problem = ok && v.size() == cols && row_problem ? row_problem(v) : "";
+    if (!ok || v.size() != cols || !problem.empty())
       bad(key, path,
-          "rows of 3 finite numbers Ω¹₀, Ω²₀, Ω³₀ (rad/Å) separated by commas ('#' lines are "
-          "comments), but line " +
-              std::to_string(line_no) + " is \"" + detail::echo(line) + "\"");
-    out.emplace_back(v[0], v[1], v[2]);
+          "rows of " + std::to_string(cols) + " finite numbers " + what +
+              " separated by commas ('#' lines are comments), but line " + std::to_string(line_no) +
+              " is \"" + detail::echo(line) + "\"" + (problem.empty() ? "" : " (" + problem + ")"));
+    out.push_back(std::move(v));
   }
   if (int(out.size()) != n)
     bad(key, path,
         "one row per rod point, rod.base_pairs = " + std::to_string(n) + " rows, but it has " +
             std::to_string(out.size()));
+  return out;
+}
+
+}  // namespace
+
+std::vector<Vec3> read_intrinsic_file(const std::string& path, int n) {
+  std::vector<Vec3> out;
+  if (path.empty()) return out;
+  for (const auto& v :
+       read_rows("rod.intrinsic_file", path, n, 3, "Ω¹₀, Ω²₀, Ω³₀ (rad/Å)", nullptr))
+    out.emplace_back(v[0], v[1], v[2]);
+  return out;
+}
+
+std::pair<std::vector<Vec3>, std::vector<Vec3>> read_moduli_file(const std::string& path, int n) {
+  std::pair<std::vector<Vec3>, std::vector<Vec3>> out;
+  if (path.empty()) return out;
+  // each value > 0 and, as the scalar keys, within 20 decades of MODEL §1's value
+  static const char* names[6] = {"a1", "a2", "a3", "b1", "b2", "b3"};
+  static const double ref[6] = {1.3e-19, 1.3e-19, 1.82e-19, 5e-5, 5e-5, 5e-5};
+  const auto row_problem = [](const std::vector<double>& v) -> std::string {
+    for (int i = 0; i < 6; ++i) {
+      if (!(v[i] > 0)) return std::string(names[i]) + " = " + fmt(v[i]) + " is not > 0";
+      if (!(v[i] >= ref[i] * 1e-20 && v[i] <= ref[i] * 1e20))
+        return std::string(names[i]) + " = " + fmt(v[i]) + " is outside " + fmt(ref[i] * 1e-20) +
+               " to " + fmt(ref[i] * 1e20) + ", 20 decades about " + fmt(ref[i]);
+    }
+    return "";
+  };
+  for (const auto& v : read_rows("rod.moduli_file", path, n, 6,
+                                 "> 0, a1, a2, a3 (erg·cm) and b1, b2, b3 (dyn),", row_problem)) {
+    out.first.emplace_back(v[0] * units::erg_cm, v[1] * units::erg_cm, v[2] * units::erg_cm);
+    out.second.emplace_back(v[3] * units::dyn, v[4] * units::dyn, v[5] * units::dyn);
+  }
   return out;
 }
 
@@ -215,6 +259,25 @@ rod::RodParams rod_params(const Config& c) {
               "triads), but row " +
               std::to_string(k + 1) + " exceeds it");
   r.closed = c.rod_closed;
+  std::tie(r.a_k, r.b_k) = read_moduli_file(c.rod_moduli_file, c.rod_base_pairs);
+  if (!r.a_k.empty()) {
+    // the scalars become the means over the links in use (n closed, n − 1 open): the twisted
+    // circle's tilt sin β (docs/config.md "rod.moduli_file")
+    const int m = rod::half_points(r.n, r.closed);
+    r.a = r.b = Vec3::Zero();
+    for (int k = 0; k < m; ++k) {
+      r.a += r.a_k[k] / m;
+      r.b += r.b_k[k] / m;
+    }
+    const double r0 = rod::circle_radius(c.rod_base_pairs, c.rod_rise_A);
+    const double sin_beta =
+        rod::circle_tilt_sin_beta(r.a.x(), r.a.z(), r.b.x(), r0, c.rod_excess_link);
+    if (c.rod_closed && !(std::abs(sin_beta) < 1))
+      bad("rod.excess_link", std::to_string(c.rod_excess_link),
+          "a link small enough that the twisted circle exists at the mean moduli of "
+          "rod.moduli_file = \"" +
+              c.rod_moduli_file + "\" (|sin β| = " + fmt(std::abs(sin_beta)) + " >= 1)");
+  }
   return r;
 }
 
@@ -387,8 +450,27 @@ double stable_dt_limit_ns(const Config& c) {
   // MODEL §1's moduli and viscosity is stable to 0.22 ns with c = h = 725/64 Å, and to 0.9 ns
   // but not 1.3 ns with c = h = 725/32 Å: the limit grows as c². The implicit scheme is stable
   // to 20× the explicit limit (4.4 ns at the reference).
+  // A rod stiffer than MODEL §1's lowers it as 1/stiffness (the explicit update of a stiff spring
+  // is stable for Δt < 2/(mobility × stiffness)), each modulus taken per link with
+  // rod.moduli_file (the stiffest link). Measured at c = 725/32 Å (docs/config.md): the shear and
+  // stretch set the limit (b1 or b3 doubled: unstable at 0.9 and 0.6 ns, stable at 0.45), the
+  // bending and twist only beyond 4× (a1, a3 ×4: stable at 0.9 ns; ×8: unstable), so the factor
+  // is max(1, b/b_ref, a/(4 a_ref)); a softer rod keeps the measured limit.
   const double c_ref = 725.0 / 64, c_A = c.grid_kernel_width * c.grid_box_A / c.grid_n;
-  const double explicit_limit = 0.22 * (c_A / c_ref) * (c_A / c_ref);
+  Vec3 a_max(c.rod_bend_modulus_erg_cm, c.rod_bend_modulus_erg_cm, c.rod_twist_modulus_erg_cm);
+  Vec3 b_max(c.rod_shear_modulus_dyn, c.rod_shear_modulus_dyn, c.rod_stretch_modulus_dyn);
+  if (!c.rod_moduli_file.empty()) {
+    const auto [a_k, b_k] = read_moduli_file(c.rod_moduli_file, c.rod_base_pairs);
+    a_max = b_max = Vec3::Zero();
+    for (int k = 0; k < rod::half_points(c.rod_base_pairs, c.rod_closed); ++k) {
+      a_max = a_max.cwiseMax(a_k[k] / units::erg_cm);
+      b_max = b_max.cwiseMax(b_k[k] / units::dyn);
+    }
+  }
+  const double stiffer =
+      std::max({1.0, b_max.x() / 5e-5, b_max.y() / 5e-5, b_max.z() / 5e-5,
+                a_max.x() / (4 * 1.3e-19), a_max.y() / (4 * 1.3e-19), a_max.z() / (4 * 1.82e-19)});
+  const double explicit_limit = 0.22 * (c_A / c_ref) * (c_A / c_ref) / stiffer;
   return c.time_scheme == "implicit" ? 20 * explicit_limit : explicit_limit;
 }
 

@@ -247,6 +247,26 @@ Key intrinsic_file_key() {
   return k;
 }
 
+// rod.moduli_file: a file name (a string key; "" for none); read by to_params
+Key moduli_file_key() {
+  Key k;
+  k.name = "rod.moduli_file";
+  k.help =
+      "per-link moduli: a CSV with one row per rod point, a1, a2, a3 in erg·cm and b1, b2, b3 in "
+      "dyn (row k: link k → k+1); replaces rod.bend_modulus_erg_cm, rod.twist_modulus_erg_cm, "
+      "rod.shear_modulus_dyn and rod.stretch_modulus_dyn; \"\": those keys";
+  k.set = [](Config& c, const toml::node& n) {
+    const auto v = n.value_exact<std::string>();
+    if (!v) bad("rod.moduli_file", show(n), "a file name in quotes, or \"\" for none");
+    c.rod_moduli_file = *v;
+  };
+  k.put = [](const Config& c, toml::table& t) {
+    t.insert_or_assign("moduli_file", c.rod_moduli_file);
+  };
+  k.value = [](const Config& c) { return "\"" + c.rod_moduli_file + "\""; };
+  return k;
+}
+
 // rod.initial_shape: a file name (a string key; "" for none)
 Key initial_shape_key() {
   Key k;
@@ -393,6 +413,7 @@ const std::vector<Key>& schema() {
            "intrinsic twist Ω³₀, rad/Å (0: untwisted reference)"),
       intrinsic_curvature_key(),
       intrinsic_file_key(),
+      moduli_file_key(),
       initial_shape_key(),
       boolean("rod.closed", &Config::rod_closed,
               "true: a closed ring; false: an open rod with two free ends, straight along x "

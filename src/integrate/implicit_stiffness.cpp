@@ -35,6 +35,16 @@ std::vector<int> colouring(int n) {
   return c;
 }
 
+// C = diag(b1, b2, b3, a1, a2, a3) of half point h: the link's moduli (rod.moduli_file) or the
+// scalars.
+Eigen::Matrix<double, 6, 1> moduli(const rod::RodParams& rp, int h) {
+  const Vec3& a = rp.a_k.empty() ? rp.a : rp.a_k[h];
+  const Vec3& b = rp.b_k.empty() ? rp.b : rp.b_k[h];
+  Eigen::Matrix<double, 6, 1> c;
+  c << b.x(), b.y(), b.z(), a.x(), a.y(), a.z();
+  return c;
+}
+
 }  // namespace
 
 namespace detail {
@@ -112,7 +122,8 @@ void ImplicitStepper::gn_blocks(const rod::RodState& s) {
   //   δΓ_i = D^i·(δX_{k+1} − δX_k)/Δs + ½ (D^i × X′)·(δθ_k + δθ_{k+1})
   //   δΩ_i = D^i·(δθ_{k+1} − δθ_k)/Δs
   // (a common rotation leaves Γ unchanged; the half-point triad turns by the mean of its two
-  // ends'). K = Δs Σ_h J_hᵀ C J_h, C = diag(b1, b2, b3, a1, a2, a3): symmetric positive
+  // ends'). K = Δs Σ_h J_hᵀ C_h J_h, C_h = diag(b1, b2, b3, a1, a2, a3) of link h (per link with
+  // rod.moduli_file): symmetric positive
   // semi-definite, O(n), block-cyclic-tridiagonal: Kd_[k] = K[k][k], Ko_[k] = K[k+1][k].
   // tests/unit/integrate/test_implicit_parts.cpp compares it with the finite-difference K.
   const int n = s.size();
@@ -120,10 +131,9 @@ void ImplicitStepper::gn_blocks(const rod::RodState& s) {
   using Mat6 = Eigen::Matrix<double, 6, 6>;
   Kd_.assign(n, Mat6::Zero());
   Ko_.assign(n, Mat6::Zero());
-  Eigen::Matrix<double, 6, 1> c;
-  c << rp.b.x(), rp.b.y(), rp.b.z(), rp.a.x(), rp.a.y(), rp.a.z();
   for (int h = 0; h < n; ++h) {
     const int h1 = (h + 1) % n;
+    const Eigen::Matrix<double, 6, 1> c = moduli(rp, h);
     const Mat3 Dh = rod::half_point_triad(s.D[h], s.D[h1]);
     const Vec3 xp = (s.X[h1] - s.X[h]) / rp.ds;
     Mat3 G;  // rows (D^i × X′)ᵀ
@@ -238,11 +248,10 @@ Eigen::SparseMatrix<double> ImplicitStepper::stiffness(const rod::RodState& s) {
     }
   }
   if (p_.gauss_newton) {
-    // K = Δs Σ_h J_hᵀ C J_h = Δs Σ_h S_hᵀ C⁻¹ S_h over the points h, h+1 of each half point
-    Vec6 cinv;
-    cinv << 1 / rp.b.x(), 1 / rp.b.y(), 1 / rp.b.z(), 1 / rp.a.x(), 1 / rp.a.y(), 1 / rp.a.z();
+    // K = Δs Σ_h J_hᵀ C_h J_h = Δs Σ_h S_hᵀ C_h⁻¹ S_h over the points h, h+1 of each half point
     for (int h = 0; h < n; ++h) {
       const int h1 = (h + 1) % n;
+      const Vec6 cinv = moduli(rp, h).cwiseInverse();
       const int idx[2] = {h, h1};
       const Mat6* S[2] = {&SL[h], &SR[h]};
       for (int a = 0; a < 2; ++a)

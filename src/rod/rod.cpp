@@ -47,8 +47,8 @@ inline HalfPoint eval_half(const RodParams& p, int k, const Vec3& Xk, const Vec3
   gamma.z() -= 1.0;
   const Vec3 dom = omega - (p.omega0_k.empty() ? p.omega0 : p.omega0_k[k]);
   // Constitutive laws MODEL (2.5–2.8): body components, then to the lab frame.
-  const Vec3 Nb = p.a.cwiseProduct(dom);
-  const Vec3 Fb = p.b.cwiseProduct(gamma);
+  const Vec3 Nb = (p.a_k.empty() ? p.a : p.a_k[k]).cwiseProduct(dom);
+  const Vec3 Fb = (p.b_k.empty() ? p.b : p.b_k[k]).cwiseProduct(gamma);
   h.Nh = h.Dh * Nb;
   h.Fh = h.Dh * Fb;
   // MODEL (2.13) discretised: E_h = (Δs/2) Σ [Σ bᵢΓᵢ² + Σ aᵢ(Ωᵢ − Ωᵢ₀)²].
@@ -75,6 +75,8 @@ ElasticEnergy elastic_forces(const RodParams& p, const RodState& s, RodWork& w, 
   check_size(F.size(), n, "F");
   check_size(T.size(), n, "T");
   if (!p.omega0_k.empty()) check_size(p.omega0_k.size(), n, "omega0_k");
+  if (!p.a_k.empty()) check_size(p.a_k.size(), n, "a_k");
+  if (!p.b_k.empty()) check_size(p.b_k.size(), n, "b_k");
   if (w.Dh.size() != std::size_t(n) || w.Fh.size() != std::size_t(n) ||
       w.Nh.size() != std::size_t(n) || w.Xp.size() != std::size_t(n) ||
       w.Eh.size() != std::size_t(n))
@@ -136,6 +138,8 @@ ElasticEnergy elastic_energy(const RodParams& p, const RodState& s) {
   const int n = s.size();
   check_size(s.D.size(), n, "D");
   if (!p.omega0_k.empty()) check_size(p.omega0_k.size(), n, "omega0_k");
+  if (!p.a_k.empty()) check_size(p.a_k.size(), n, "a_k");
+  if (!p.b_k.empty()) check_size(p.b_k.size(), n, "b_k");
   Vec3 e = Vec3::Zero();
   for (int k = 0; k < half_points(n, p.closed); ++k) {
     const int k1 = (k + 1 == n) ? 0 : k + 1;

@@ -23,6 +23,11 @@ struct RodParams {
   /// Per link: omega0_k[k] replaces omega0 at half point k+½ (link k → k+1) when not empty; size
   /// n (an open rod uses the first n − 1). rod.intrinsic_file (docs/config.md).
   std::vector<Vec3> omega0_k;
+  /// Per link: a_k[k], b_k[k] replace a, b at half point k+½ (link k → k+1) when not empty; size
+  /// n each (an open rod uses the first n − 1); given together or not at all. rod.moduli_file
+  /// (docs/config.md), which also sets a, b to the per-link means (the twisted circle's tilt).
+  std::vector<Vec3> a_k;
+  std::vector<Vec3> b_k;
   bool closed = true;  ///< closed ring (X_n = X_0) or open rod with two free ends
 };
 
@@ -35,7 +40,8 @@ struct RodState {
   int size() const { return int(X.size()); }
 };
 
-/// Elastic energy split as the diagnostics report it, g Å² s⁻².
+/// Elastic energy split as the diagnostics report it, g Å² s⁻² (sums over the half points k+½;
+/// aᵢ, bᵢ and Ωᵢ₀ are those of link k when a_k, b_k, omega0_k are given).
 struct ElasticEnergy {
   double bend = 0;     ///< (Δs/2) Σ a1 (Ω¹−Ω¹₀)² + a2 (Ω²−Ω²₀)²
   double twist = 0;    ///< (Δs/2) Σ a3 (Ω³−Ω³₀)²
@@ -81,9 +87,10 @@ void advance(RodState& s, std::span<const Vec3> U, std::span<const Vec3> W, doub
 
 /// Initial condition of MODEL §5: the twisted circle of radius r0 = n Δs / 2π in the z = 0 plane,
 /// centred at `center`, excess link ΔLk, twist perturbation g(s) = Σ_m eps[m−1] sin(m s / r0).
-/// sin β = −a3 ΔLk / (b1 r0² + a3 − a1). Uses p.n, p.ds, a1, a3, b1; an equilibrium (to O(Δs²))
-/// only for ε = 0, a1 = a2, b1 = b2 = b3 and zero intrinsic strains. Throws ConfigError for
-/// n < 3, ds ≤ 0 or |sin β| > 1.
+/// sin β = −a3 ΔLk / (b1 r0² + a3 − a1). Uses p.n, p.ds and the scalars a1, a3, b1 (never a_k,
+/// b_k: with per-link moduli to_params sets the scalars to their means); an equilibrium (to
+/// O(Δs²)) only for ε = 0, a1 = a2, b1 = b2 = b3, uniform moduli and zero intrinsic strains. Throws
+/// ConfigError for n < 3, ds ≤ 0 or |sin β| > 1.
 struct CircleParams {
   int excess_link = 6;
   std::vector<double> perturbation{1.0};  ///< ε_m for m = 1, 2, … (radians)

@@ -11,7 +11,10 @@ namespace ibrod::sim {
 
 double spacing_tolerance(const rod::RodParams& rod, double thermal_kT) {
   if (!(thermal_kT > 0)) return 0.5;
-  const double b = std::min(rod.b[0], std::min(rod.b[1], rod.b[2]));
+  double b = rod.b.minCoeff();  // the softest shear or stretch (per link: rod.moduli_file)
+  if (!rod.b_k.empty())         // the links in use (an open rod's last row is not)
+    for (int k = 0; k < rod::half_points(rod.n, rod.closed); ++k)
+      b = std::min(b, rod.b_k[k].minCoeff());
   return std::max(0.5, 7.0 * std::sqrt(thermal_kT * rod.ds / b) / rod.ds);
 }
 

@@ -16,8 +16,8 @@ std::string rod_problem(const rod::RodState& s, double ds, double tolerance = 0.
 
 /// The spacing tolerance of rod_problem for a run: 0.5, or with thermal noise (docs/thermal.md)
 /// seven standard deviations of the thermal stretch or shear of one segment,
-/// 7 √(kT Δs / min(b1, b3)) / Δs, if that is larger (0.94 · 7/6 for the reference parameters:
-/// a 50 % stretch is a 3σ event there, not a blow-up).
+/// 7 √(kT Δs / min(b1, b3)) / Δs (the softest link's with rod.moduli_file), if that is larger (0.94
+/// · 7/6 for the reference parameters: a 50 % stretch is a 3σ event there, not a blow-up).
 double spacing_tolerance(const rod::RodParams& rod, double thermal_kT);
 
 /// Empty if `s` may be a rod of n points Δs = ds apart (an initial shape, a state set from

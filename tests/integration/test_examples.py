@@ -38,7 +38,8 @@ def header(path):
 
 
 def run(ibrod, *args, timeout=300):
-    return subprocess.run([ibrod, *args], capture_output=True, text=True, timeout=timeout,
+    # from the repository root: the examples name their data files by paths from it
+    return subprocess.run([ibrod, *args], capture_output=True, text=True, timeout=timeout, cwd=ROOT,
                           stdin=subprocess.DEVNULL, env=dict(os.environ, OMP_WAIT_POLICY="passive"))
 
 

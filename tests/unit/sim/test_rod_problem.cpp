@@ -53,3 +53,22 @@ TEST(RodProblem, AStateMustHaveTheRodsPointsAndRightHandedTriads) {
   gap.X[5] *= 2.0;  // 2.1 Δs from point 4: a spacing the run would call a blow-up
   EXPECT_THAT(sim::state_problem(gap, 10, ds), HasSubstr("spacing of points 4 and 5"));
 }
+
+// With per-link moduli (rod.moduli_file) the thermal spacing tolerance follows the softest link
+// in use: one link 100× softer in stretch widens it 10×; an open rod's last row (no link) does not.
+TEST(SpacingTolerance, FollowsTheSoftestLinkInUse) {
+  rod::RodParams p;
+  p.n = 50;
+  const double kT = 414.2;
+  const double base = sim::spacing_tolerance(p, 1e3 * kT);  // thermal: above the 0.5 floor
+  ASSERT_GT(base, 0.5);
+  p.a_k.assign(p.n, p.a);
+  p.b_k.assign(p.n, p.b);
+  EXPECT_EQ(sim::spacing_tolerance(p, 1e3 * kT), base);
+  p.b_k[p.n - 1].z() /= 100;
+  EXPECT_NEAR(sim::spacing_tolerance(p, 1e3 * kT), 10 * base, 1e-9 * base);
+  p.closed = false;  // the last row is not a link of the open rod
+  EXPECT_EQ(sim::spacing_tolerance(p, 1e3 * kT), base);
+  p.b_k[3].x() /= 100;
+  EXPECT_NEAR(sim::spacing_tolerance(p, 1e3 * kT), 10 * base, 1e-9 * base);
+}
