@@ -91,7 +91,9 @@ void Run::State::build_simulation() {
     sim->set_rod_state(std::move(*initial_shape));  // checked in Run::Run
     initial_shape.reset();
   }
-  if (!rod_shapes.empty() && !checkpoint) {
+  const bool any_shape =
+      std::any_of(rod_shapes.begin(), rod_shapes.end(), [](const auto& r) { return bool(r); });
+  if (any_shape && !checkpoint) {
     // several rods: each rod with rod.initial_shape takes its shape from its file, in its range
     rod::RodState whole = sim->rod();
     for (std::size_t r = 0; r < rod_shapes.size(); ++r) {

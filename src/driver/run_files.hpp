@@ -62,7 +62,11 @@ class RunFiles {
     if (resume_step < 0) {
       io::write_file_atomic(ts, io::timeseries_header() + "\n");
       if (several) io::write_file_atomic(dir.rods(), rods_header + "\n");
-      if (frames_on_) h5_ = io::H5mdWriter::create(dir.trajectory(), n, c.grid_box_A, config_text);
+      std::vector<int> species;  // several rods: each point's rod
+      for (std::size_t r = 0; several && r < ranges_.size(); ++r)
+        species.insert(species.end(), std::size_t(ranges_[r].n), int(r));
+      if (frames_on_)
+        h5_ = io::H5mdWriter::create(dir.trajectory(), n, c.grid_box_A, config_text, species);
     } else {
       io::write_file_atomic(
           ts, io::timeseries_up_to(try_read_text_file(ts).value_or(""), io::timeseries_header(),

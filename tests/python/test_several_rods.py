@@ -64,7 +64,7 @@ def test_initial_shape_of_each_rod_from_a_run_of_several(tmp_path):
     assert np.array_equal(b.triads, ref["triads"])
     # a run of one rod cannot take a file of several
     one = ibrod.Config()
-    one.update({"grid.n": 16, "grid.box_A": 200, "rod.base_pairs": 200, "rod.excess_link": 0,
+    one.update({"grid.n": 16, "grid.box_A": 400, "rod.base_pairs": 200, "rod.excess_link": 0,
                 "rod.initial_shape": path})
     with pytest.raises(ibrod.ConfigError, match="holds 2 rods"):
         ibrod.Simulation(one)

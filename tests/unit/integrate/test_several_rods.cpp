@@ -210,5 +210,33 @@ TEST(SeveralRods, StateChecksEachRodApart) {
   EXPECT_THROW(sim.set_rod_state(s), std::invalid_argument);
 }
 
+TEST(SeveralRods, OneTableIsTheRodItselfBitForBit) {
+  // [[rods]] with one empty table is the run of [rod]: the same state after 50 steps
+  config::Config plain;
+  plain.grid_n = 16;
+  plain.grid_box_A = 200;
+  plain.rod_base_pairs = 60;
+  plain.rod_excess_link = 2;
+  plain.run_threads = 1;
+  plain.run_fftw_measure = false;
+  config::Config one = plain;
+  config::apply_toml(one, "[[rods]]\n", "one.toml");
+  ASSERT_EQ(one.rods.size(), 1u);
+  config::validate(one);
+  sim::Simulation a(config::to_params(plain)), b(config::to_params(one));
+  for (int k = 0; k < 50; ++k) {
+    a.step();
+    b.step();
+  }
+  EXPECT_EQ(a.rod().X, b.rod().X);
+  EXPECT_EQ(a.rod().D, b.rod().D);
+  // and a second, identical table: twice the points, each ring moving as the pair dictates
+  config::Config two = one;
+  config::apply_override(two, "rods.1.offset_A=[0, 0, 40]");
+  sim::Simulation c(config::to_params(two));
+  EXPECT_EQ(c.rod().size(), 120);
+  EXPECT_EQ(c.rods().size(), 2u);
+}
+
 }  // namespace
 }  // namespace ibrod::integrate
