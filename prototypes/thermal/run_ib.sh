@@ -4,7 +4,8 @@
 # Usage: prototypes/thermal/run_ib.sh OUTDIR [T_US]   (from the repository root; ~3-15 s per µs here)
 #        PROBES=1 prototypes/thermal/run_ib.sh OUTDIR [T_US]: the two probes at the end instead
 #        PROBES=2 prototypes/thermal/run_ib.sh OUTDIR: the time-step probes of "Which suspect it
-#                 was" (ΔLk = 0 at Δt = 0.05 and 0.025 ns, ΔLk = 1 at 0.05 ns; 5, 3 and 8 µs)
+#                 was" (ΔLk = 0 at Δt = 0.05 ns, seeds 2, 4, 5 µs, and 0.025 ns, seed 3, 3 µs;
+#                 ΔLk = 1 at 0.05 ns, seeds 3, 4, 8 µs)
 #        DRIFT=false …: without the stochastic drift (solvent.thermal_drift = false), as the runs
 #                 of "Writhe and shape against Monte Carlo" were made; default true
 set -euo pipefail
@@ -32,10 +33,15 @@ if [ "${PROBES:-0}" = 1 ]; then
 fi
 # the time-step probes (one frame every 2 ns, one row every 1 ns at each Δt)
 if [ "${PROBES:-0}" = 2 ]; then
-  run -o "$out/ib_dlk0_dt05" --set run.seed=2 --set time.dt_ns=0.05 \
-    --set output.every_steps=20 --set output.frame_every_steps=40 --set time.t_end_us=5
-  run -o "$out/ib_dlk0_dt025" --set run.seed=3 --set time.dt_ns=0.025 \
+  for seed in 2 4; do
+    run -o "$out/ib_dlk0_dt05_s$seed" --set run.seed=$seed --set time.dt_ns=0.05 \
+      --set output.every_steps=20 --set output.frame_every_steps=40 --set time.t_end_us=5
+  done
+  run -o "$out/ib_dlk0_dt025_s3" --set run.seed=3 --set time.dt_ns=0.025 \
     --set output.every_steps=40 --set output.frame_every_steps=80 --set time.t_end_us=3
-  run -o "$out/ib_dlk1_dt05" --set run.seed=3 --set rod.excess_link=1 --set time.dt_ns=0.05 \
-    --set output.every_steps=20 --set output.frame_every_steps=40 --set time.t_end_us=8
+  for seed in 3 4; do
+    run -o "$out/ib_dlk1_dt05_s$seed" --set run.seed=$seed --set rod.excess_link=1 \
+      --set time.dt_ns=0.05 --set output.every_steps=20 --set output.frame_every_steps=40 \
+      --set time.t_end_us=8
+  done
 fi
