@@ -1,26 +1,47 @@
 #!/bin/bash
 # The IB half of the equilibrium check (docs/thermal.md): thermal runs of the 100 bp ring of
 # ring.toml at ΔLk = 0 and 1, two seeds each, T_US µs each (10 by default), one thread, niced.
-# Usage: prototypes/thermal/run_ib.sh OUTDIR [T_US]   (from the repository root; ~15 s per µs here)
+# Usage: prototypes/thermal/run_ib.sh OUTDIR [T_US]   (from the repository root; ~3-15 s per µs here)
 #        PROBES=1 prototypes/thermal/run_ib.sh OUTDIR [T_US]: the two probes at the end instead
+#        PROBES=2 prototypes/thermal/run_ib.sh OUTDIR: the time-step probes of "Which suspect it
+#                 was" (ΔLk = 0 at Δt = 0.05 ns, seeds 2, 4, 5 µs, and 0.025 ns, seed 3, 3 µs;
+#                 ΔLk = 1 at 0.05 ns, seeds 3, 4, 8 µs)
+#        DRIFT=false …: without the stochastic drift (solvent.thermal_drift = false), as the runs
+#                 of "Writhe and shape against Monte Carlo" were made; default true
 set -euo pipefail
 out=${1:?usage: run_ib.sh OUTDIR [T_US]}
 t_us=${2:-10}
 ibrod=${IBROD:-./build/app/ibrod}
+drift=${DRIFT:-true}
 mkdir -p "$out"
-[ "${PROBES:-0}" = 1 ] || for dlk in 0 1; do
+run() { nice -n 10 "$ibrod" run prototypes/thermal/ring.toml --set solvent.thermal_drift="$drift" "$@" >/dev/null; }
+[ "${PROBES:-0}" != 0 ] || for dlk in 0 1; do
   for seed in 1 2; do
-    nice -n 10 "$ibrod" run prototypes/thermal/ring.toml -o "$out/ib_dlk${dlk}_s${seed}" \
-      --set rod.excess_link=$dlk --set run.seed=$seed --set time.t_end_us="$t_us" >/dev/null
+    run -o "$out/ib_dlk${dlk}_s${seed}" --set rod.excess_link=$dlk --set run.seed=$seed \
+      --set time.t_end_us="$t_us"
   done
 done
 # the two probes of what differs (ΔLk = 0, seed 3): half the time step at 16³, and 32³ (h halved;
 # its explicit limit is ~0.07 ns, so Δt = 0.05 ns), T_US/2 and T_US/5 µs
 if [ "${PROBES:-0}" = 1 ]; then
-  nice -n 10 "$ibrod" run prototypes/thermal/ring.toml -o "$out/ib_dlk0_dt05" --set run.seed=3 \
+  run -o "$out/ib_dlk0_dt05" --set run.seed=3 \
     --set time.dt_ns=0.05 --set output.every_steps=20 --set output.frame_every_steps=40 \
-    --set time.t_end_us="$(echo "$t_us / 2" | bc -l)" >/dev/null
-  nice -n 10 "$ibrod" run prototypes/thermal/ring.toml -o "$out/ib_dlk0_n32" --set run.seed=3 \
+    --set time.t_end_us="$(echo "$t_us / 2" | bc -l)"
+  run -o "$out/ib_dlk0_n32" --set run.seed=3 \
     --set grid.n=32 --set time.dt_ns=0.05 --set output.every_steps=20 \
-    --set output.frame_every_steps=40 --set time.t_end_us="$(echo "$t_us / 5" | bc -l)" >/dev/null
+    --set output.frame_every_steps=40 --set time.t_end_us="$(echo "$t_us / 5" | bc -l)"
+fi
+# the time-step probes (one frame every 2 ns, one row every 1 ns at each Δt)
+if [ "${PROBES:-0}" = 2 ]; then
+  for seed in 2 4; do
+    run -o "$out/ib_dlk0_dt05_s$seed" --set run.seed=$seed --set time.dt_ns=0.05 \
+      --set output.every_steps=20 --set output.frame_every_steps=40 --set time.t_end_us=5
+  done
+  run -o "$out/ib_dlk0_dt025_s3" --set run.seed=3 --set time.dt_ns=0.025 \
+    --set output.every_steps=40 --set output.frame_every_steps=80 --set time.t_end_us=3
+  for seed in 3 4; do
+    run -o "$out/ib_dlk1_dt05_s$seed" --set run.seed=$seed --set rod.excess_link=1 \
+      --set time.dt_ns=0.05 --set output.every_steps=20 --set output.frame_every_steps=40 \
+      --set time.t_end_us=8
+  done
 fi

@@ -76,8 +76,9 @@ struct Config {
   double solvent_viscosity_poise = 0.01;
   double solvent_density_g_cm3 = 1.0;
   double solvent_temperature_K = 300.0;
-  bool solvent_advection = true;  ///< include the nonlinear advection term
-  bool solvent_thermal = false;   ///< thermal fluctuations (random stress; docs/thermal.md)
+  bool solvent_advection = true;      ///< include the nonlinear advection term
+  bool solvent_thermal = false;       ///< thermal fluctuations (random stress; docs/thermal.md)
+  bool solvent_thermal_drift = true;  ///< add the stochastic drift kT ∂·M (docs/thermal.md)
   // [external] (docs/thermal.md)
   std::vector<double> external_force_pN{0.0, 0.0, 0.0};      ///< total force on the rod, pN
   std::vector<double> external_torque_pN_nm{0.0, 0.0, 0.0};  ///< torque about its centre, pN·nm

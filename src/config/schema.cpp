@@ -438,6 +438,9 @@ const std::vector<Key>& schema() {
       boolean("solvent.thermal", &Config::solvent_thermal,
               "thermal fluctuations at solvent.temperature_K: a random stress in the fluid, keyed "
               "by run.seed (explicit scheme; docs/thermal.md)"),
+      boolean("solvent.thermal_drift", &Config::solvent_thermal_drift,
+              "with solvent.thermal: add the stochastic drift kT ∂·M by a random finite "
+              "difference of the spreading and a midpoint interpolation (docs/thermal.md)"),
       vec3_key("external.force_pN", &Config::external_force_pN, 1e6,
                "total external force on the rod, spread evenly over its points, pN"),
       vec3_key("external.torque_pN_nm", &Config::external_torque_pN_nm, 1e8,

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 
+#include "core/philox.hpp"
+
 #include <omp.h>
 
 #include <algorithm>
@@ -64,7 +66,7 @@ Stepper::Stepper(const StepperParams& p)
       fluid_(make_serial(p)),
       dist_(make_distributed(p)),
       coupler_(p.grid, p.kernel_width, slab_of(p.grid, dist_.get())),
-      plane_coupler_(coupler_, point_count(p)),
+      plane_coupler_(coupler_, p.thermal_drift ? 3 * point_count(p) : point_count(p)),
       electro_(p.electro, point_count(p)),
       steric_(steric_of(p), point_count(p)) {
   const int n = point_count(p);
@@ -228,6 +230,10 @@ void Stepper::step(rod::RodState& s, StepPhaseTimes* phases) {
     rod::advance(s, U_, W_, p_.fluid.dt);
     return;
   }
+  if (p_.thermal_drift && p_.fluid.thermal_kT > 0) {
+    drift_step(s, clock);
+    return;
+  }
   // fⁿ = spread(F, T) is added to r = ρuⁿ/Δt − ρS_h(uⁿ) plane by plane inside the fluid step
   // (MODEL §4), and U, W at Xⁿ are sampled from uⁿ⁺¹ plane by plane: the kernel weights are
   // evaluated once, and no grid-sized pass is spent on either (FluidSolver::step's three passes,
@@ -245,6 +251,57 @@ void Stepper::step(rod::RodState& s, StepPhaseTimes* phases) {
   plane_coupler_.finish_interpolation(U_, W_);
   clock.mark(6);
   rod::advance(s, U_, W_, p_.fluid.dt);
+  clock.mark(7);
+}
+
+// The step with the stochastic drift kT ∂_X·M (StepperParams::thermal_drift; docs/thermal.md,
+// "The stochastic drift"). With M = J L⁻¹ S, ∂_X·M = J L⁻¹ (∂_X·S) + (∂_X J) : L⁻¹ S:
+// the first term by a random finite difference of the spreading, the force pairs ±(kT/δ) W̃_k at
+// X_k ± (δ/2) W̃_k (W̃ of mean 0 and unit covariance, keyed by the seed and the noise step like
+// the random stress, counter word 1 = 1) spread with the rod's forces; the second by
+// interpolating uⁿ⁺¹ at the midpoint X̃ = Xⁿ + (Δt/2) J(Xⁿ) uⁿ⁺¹ (its mean over the noise is
+// (Δt²/2) (∂J) : ⟨u uᵀ⟩ J ᵀ = kT Δt (∂J) : L⁻¹ S where the per-step velocity covariance is
+// 2kT L⁻¹/Δt, the grid-scale modes that carry the drift).
+void Stepper::drift_step(rod::RodState& s, PhaseClock& clock) {
+  const std::size_t n = s.X.size();
+  const double kT = p_.fluid.thermal_kT, dt = p_.fluid.dt;
+  const double delta = 1e-4 * p_.grid.h();  // Å: the RFD's cancellation error ~ 1e-16 h/δ
+  const std::uint64_t step = fluid_->noise_step(), seed = p_.fluid.seed;
+  const std::uint32_t key0 = std::uint32_t(seed), key1 = std::uint32_t(seed >> 32);
+  const std::uint32_t st0 = std::uint32_t(step), st1 = std::uint32_t(step >> 32);
+  Xa_.resize(3 * n);
+  Fa_.resize(3 * n);
+  Ta_.assign(3 * n, Vec3::Zero());
+  Ua_.resize(3 * n);
+  Wa_.resize(3 * n);
+  for (std::size_t k = 0; k < n; ++k) {
+    double z[6];
+    unit_variance6(philox4x32_10({std::uint32_t(k), 1u, st0, st1}, key0, key1), z);
+    const Vec3 w(z[0], z[1], z[2]);
+    Xa_[k] = s.X[k];
+    Fa_[k] = F_[k];
+    Ta_[k] = T_[k];
+    Xa_[n + k] = s.X[k] + (0.5 * delta) * w;
+    Xa_[2 * n + k] = s.X[k] - (0.5 * delta) * w;
+    Fa_[n + k] = (kT / delta) * w;
+    Fa_[2 * n + k] = -(kT / delta) * w;
+  }
+  plane_coupler_.prepare(Xa_, Fa_, Ta_);
+  clock.mark(2);
+  const PlaneCouplerForcing forcing(plane_coupler_);
+  const PlaneCouplerSampler sampler(plane_coupler_);
+  fluid_->pass_rhs_planes(&forcing);
+  clock.mark(3);
+  fluid_->pass_pencils();
+  clock.mark(4);
+  fluid_->pass_inverse_planes(&sampler);
+  clock.mark(5);
+  plane_coupler_.finish_interpolation(Ua_, Wa_);
+  for (std::size_t k = 0; k < n; ++k) Xa_[k] = s.X[k] + (0.5 * dt) * Ua_[k];
+  coupler_.interpolate(std::span<const Vec3>(Xa_.data(), n),
+                       {fluid_->velocity(0), fluid_->velocity(1), fluid_->velocity(2)}, U_, W_);
+  clock.mark(6);
+  rod::advance(s, U_, W_, dt);
   clock.mark(7);
 }
 

@@ -54,6 +54,11 @@ struct StepperParams {
   /// Σ (X_k − X̄) × (ω × (X_k − X̄)) = torque (they add no net force)
   Vec3 external_force = Vec3::Zero();
   Vec3 external_torque = Vec3::Zero();
+  /// with thermal noise (fluid.thermal_kT > 0): add the stochastic drift kT ∂_X·M(X) of the
+  /// overdamped limit (docs/thermal.md, "The stochastic drift"): a random finite difference of
+  /// the spreading, (kT/δ)[S(X + δW̃/2) − S(X − δW̃/2)]W̃ into the fluid, and U, W interpolated
+  /// at the midpoint Xⁿ + (Δt/2)Uⁿ⁺¹ of a predictor step
+  bool thermal_drift = false;
 };
 
 /// Every rod of p, in the state's order: p.rod, then p.more_rods.
@@ -155,6 +160,8 @@ class Stepper {
   // [n] point forces (g Å s⁻²), torques (g Å² s⁻²), velocities U (Å s⁻¹), angular
   // velocities W (s⁻¹)
   std::vector<Vec3> F_, T_, U_, W_;
+  std::vector<Vec3> Xa_, Fa_, Ta_, Ua_, Wa_;  // thermal_drift: the points with the RFD pairs
+  void drift_step(rod::RodState& s, PhaseClock& clock);
   std::vector<double> rank_sum_;  // distributed: [6n] U then W, packed for sum_over_ranks
   const fluid::FluidSolver* serial_fluid() const;
   StepEnergies forces(const rod::RodState& s, PhaseClock& clock);

@@ -1,5 +1,6 @@
 // Config: defaults are MODEL §1's reference table, conversions to internal units, and every kind
 // of bad input is a ConfigError naming the key.
+#include <cmath>
 #include <sstream>
 #include <vector>
 
@@ -220,4 +221,38 @@ TEST(Config, ABareWordInSetIsAStringAndAWrongTypeStillNamesTheKey) {
   } catch (const ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("grid.n"), std::string::npos) << e.what();
   }
+}
+
+// check warns of the two measured rules of a thermal run (docs/thermal.md, "Which suspect it
+// was"): the drift left out (solvent.thermal_drift = false), and a step above a quarter of the
+// explicit limit (the stiff modes hot by O(Δt)); neither without solvent.thermal.
+TEST(Config, CheckWarnsOfAThermalRunWithoutTheDriftOrWithTooLargeAStep) {
+  const auto warning = [](const std::vector<std::string>& sets, const std::string& key) {
+    config::Config c;
+    for (const auto& s : sets) config::apply_override(c, s);
+    for (const std::string& w : config::check_warnings(c))
+      if (w.find(key) != std::string::npos) return w;
+    return std::string();
+  };
+  // the thermal ring of docs/thermal.md: 16³, 200 Å box, explicit limit 0.22 (12.5/(725/64))² ns
+  const std::vector<std::string> ring{"grid.n=16", "grid.box_A=200", "rod.base_pairs=100",
+                                      "solvent.thermal=true"};
+  auto with = [&](std::vector<std::string> extra) {
+    std::vector<std::string> v = ring;
+    v.insert(v.end(), extra.begin(), extra.end());
+    return v;
+  };
+  EXPECT_EQ(warning(with({"time.dt_ns=0.05"}), "thermal_drift"), "");
+  const std::string d = warning(with({"time.dt_ns=0.05", "solvent.thermal_drift=false"}),
+                                "solvent.thermal_drift = false");
+  EXPECT_THAT(d, HasSubstr("biased")) << d;
+  EXPECT_THAT(d, HasSubstr("set solvent.thermal_drift = true")) << d;
+  EXPECT_EQ(warning({"solvent.thermal_drift=false"}, "thermal_drift"), "");  // no noise, no drift
+  const double limit = 0.22 * std::pow(12.5 / (725.0 / 64), 2);              // 0.268 ns
+  EXPECT_EQ(warning(with({"time.dt_ns=0.05"}), "quarter"), "");              // 0.19 of the limit
+  const std::string s = warning(with({"time.dt_ns=0.1"}), "quarter");        // 0.37 of the limit
+  EXPECT_THAT(s, HasSubstr("time.dt_ns = 0.1 ns is more than a quarter")) << s;
+  EXPECT_THAT(s, HasSubstr("use time.dt_ns <= 0.066 ns")) << s;
+  EXPECT_NEAR(0.25 * limit, 0.067, 0.001);
+  EXPECT_EQ(warning({"grid.n=16", "grid.box_A=200", "time.dt_ns=0.1"}, "quarter"), "");
 }
