@@ -126,7 +126,10 @@ def read_run(path):
       "frames":      dict "step" (T,), "time_us" (T,), "positions" (T, n, 3) Å, "triads"
                      (T, n, 3, 3) (row i = D^(i+1)) from trajectory.h5; None without one (needs
                      h5py)
-      "final_state": dict "positions" (n, 3), "triads" (n, 3, 3) from final_state.csv, or None
+      "final_state": dict "positions" (n, 3), "triads" (n, 3, 3) from final_state.csv, or None;
+                     with several rods also "rod" (n,): each point's rod
+      "rods":        several rods: rods.csv as dict column -> (R,) array (step, time_us,
+                     writhe_r, twist_r, link_r of each rod r); None for one rod
       "summary":     summary.json as a dict, or None
       "config":      config.toml as a dict (section -> key -> value)
     Missing directory: FileNotFoundError.
@@ -135,7 +138,10 @@ def read_run(path):
     if not os.path.isdir(path):
         raise FileNotFoundError(f"read_run: {path} is not a directory")
     out = {"timeseries": None, "frames": None, "final_state": None, "summary": None,
-           "config": None}
+           "config": None, "rods": None}
+    p = os.path.join(path, "rods.csv")
+    if os.path.exists(p):
+        out["rods"] = _read_csv(p)
     p = os.path.join(path, "timeseries.csv")
     if os.path.exists(p):
         out["timeseries"] = _read_csv(p)
@@ -148,6 +154,8 @@ def read_run(path):
             "triads": _triads(col("d1x", "d1y", "d1z"), col("d2x", "d2y", "d2z"),
                               col("d3x", "d3y", "d3z")),
         }
+        if "rod" in f:
+            out["final_state"]["rod"] = f["rod"].astype(int)
     p = os.path.join(path, "summary.json")
     if os.path.exists(p):
         with open(p) as fh:

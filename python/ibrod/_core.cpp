@@ -11,6 +11,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstring>
 #include <memory>
@@ -136,7 +137,7 @@ class PySimulation {
   }
 
   void set_state(const py::object& X_in, const py::object& D_in) {
-    const int n = run_->config().rod_base_pairs;
+    const int n = config::point_count(run_->config());
     const Array X = Array::ensure(X_in), D = Array::ensure(D_in);
     if (!X || !D) {
       PyErr_Clear();
@@ -144,7 +145,8 @@ class PySimulation {
     }
     if (X.ndim() != 2 || X.shape(0) != n || X.shape(1) != 3)
       throw std::invalid_argument("set_state: X has shape " + shape_text(X) + "; expected (" +
-                                  std::to_string(n) + ", 3) (rod.base_pairs points, Å)");
+                                  std::to_string(n) +
+                                  ", 3) (rod.base_pairs points, of all rods with [[rods]]; Å)");
     if (D.ndim() != 3 || D.shape(0) != n || D.shape(1) != 3 || D.shape(2) != 3)
       throw std::invalid_argument("set_state: D has shape " + shape_text(D) + "; expected (" +
                                   std::to_string(n) +
@@ -191,7 +193,51 @@ class PySimulation {
       for (py::ssize_t r = 0; r < R; ++r) col.mutable_data()[r] = rows[r].*(f.member);
       d[f.name] = col;
     }
+    // several rods: each rod's writhe, twist and link (rods.csv's columns)
+    const std::size_t nrods = s().rods().size();
+    for (std::size_t q = 0; nrods > 1 && q < nrods; ++q)
+      for (int which = 0; which < 3; ++which) {
+        py::array_t<double> col(R);
+        for (py::ssize_t r = 0; r < R; ++r) {
+          const auto& pr = rows[r].rods;
+          const double v = q < pr.size() ? (which == 0   ? pr[q].writhe
+                                            : which == 1 ? pr[q].twist
+                                                         : pr[q].link)
+                                         : std::nan("");
+          col.mutable_data()[r] = v;
+        }
+        d[(std::string(which == 0 ? "writhe_" : which == 1 ? "twist_" : "link_") +
+           std::to_string(q))
+              .c_str()] = col;
+      }
+    // and each pair of closed rods' linking number (rods.csv's link_a_b)
+    const auto& rp = s().rods();
+    std::size_t q = 0;
+    for (std::size_t a = 0; nrods > 1 && a < nrods; ++a)
+      for (std::size_t b = a + 1; b < nrods; ++b) {
+        if (!rp[a].closed || !rp[b].closed) continue;
+        py::array_t<double> col(R);
+        for (py::ssize_t r = 0; r < R; ++r)
+          col.mutable_data()[r] =
+              q < rows[r].pair_links.size() ? rows[r].pair_links[q] : std::nan("");
+        d[("link_" + std::to_string(a) + "_" + std::to_string(b)).c_str()] = col;
+        ++q;
+      }
     return d;
+  }
+
+  py::list rods() {
+    py::list out;
+    const auto& rp = s().rods();
+    const auto& g = s().rod_ranges();
+    for (std::size_t r = 0; r < rp.size(); ++r) {
+      py::dict d;
+      d["start"] = g[r].offset;
+      d["stop"] = g[r].offset + g[r].n;
+      d["closed"] = g[r].closed;
+      out.append(d);
+    }
+    return out;
   }
 
   const config::Config& config() { return run_->config(); }
@@ -281,7 +327,12 @@ ValueError naming the point. The fluid is left as it is.
                              "x = (i, j, k) h, Å/ns (a copy; the layout of velocity.npy).")
       .def("observables", &PySimulation::observables,
            "The time series so far as a dict of numpy arrays: step, time_us and every column "
-           "of timeseries.csv (energies in kT, lengths in Å; docs/outputs.md).")
+           "of timeseries.csv (energies in kT, lengths in Å; docs/outputs.md); with several "
+           "rods also writhe_r, twist_r, link_r of each rod r (rods.csv's columns).")
+      .def_property_readonly("rods", &PySimulation::rods,
+                             "The rods: a list of dicts {start, stop, closed}, one per rod, "
+                             "so that positions[start:stop] are that rod's points (one entry "
+                             "for a run of one rod; [[rods]]: docs/config.md).")
       .def_property_readonly(
           "step", [](PySimulation& p) { return p.s().step_count(); }, "Steps taken.")
       .def_property_readonly(

@@ -12,6 +12,7 @@
 #include <limits>
 #include <sstream>
 
+#include "config/config.hpp"
 #include "config/toml_error.hpp"
 #include "core/error.hpp"
 #include "core/text_file.hpp"
@@ -58,6 +59,16 @@ RunInfo read_run_info(const fs::path& dir) {
   info.excess_link = tbl["rod"]["excess_link"].value<int>().value_or(info.excess_link);
   info.salt_M = tbl["solvent"]["salt_M"].value<double>().value_or(info.salt_M);
   info.closed = tbl["rod"]["closed"].value<bool>().value_or(info.closed);
+  if (tbl.contains("rods")) {
+    // several rods: each table resolved on top of [rod], as the run did
+    config::Config c;
+    config::apply_toml(c, read_text_file(p, "analyze"), p.string());
+    for (int r = 0; r < config::rod_count(c); ++r) {
+      const config::Config cr = config::rod_config(c, r);
+      info.rods.push_back({cr.rod_base_pairs, cr.rod_closed});
+    }
+    if (info.rods.size() == 1) info.rods.clear();
+  }
   if (!(info.diameter_A > 0))
     throw ConfigError("'" + p.string() + "': steric.diameter_A must be positive");
   return info;
@@ -248,12 +259,12 @@ json to_json(const Analysis& a, const AnalyzeOptions& opt) {
   j["limiting_energies_kT"] = a.equilibrium ? e : json(nullptr);
   const ShapeAnalysis& sh = a.shapes;
   // the shape classes are of closed curves (docs/analysis.md): null for an open rod
-  j["shape"] = sh.final_shape && !a.open_rod
+  j["shape"] = sh.final_shape && !a.open_rod && !a.several_rods
                    ? shape_json(sh.final_shape->shape, sh.final_shape->time_us)
                    : json(nullptr);
   // null without --frames, so that an earlier analysis's frames do not outlive a new one
   json fr = opt.every_frame ? json::array() : json(nullptr);
-  if (!a.open_rod)
+  if (!a.open_rod && !a.several_rods)
     for (const auto& f : sh.frames) fr.push_back(shape_json(f.shape, f.time_us));
   j["shape_frames"] = fr;
   json contacts{{"distance_A", sh.contact_distance_A}};
@@ -299,6 +310,7 @@ Analysis analyze_run(const fs::path& dir, const AnalyzeOptions& opt) {
   const CsvTable table = read_csv_table(RunDir(dir).timeseries());
   Analysis a = analyze_timeseries(table, opt);
   const RunInfo info = read_run_info(dir);
+  a.several_rods = info.rods.size() > 1;
   const double dc = opt.contact_distance_A > 0
                         ? opt.contact_distance_A
                         : default_contact_distance(info.diameter_A, info.salt_M);

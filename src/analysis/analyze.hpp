@@ -29,6 +29,8 @@ struct RunInfo {
   int excess_link = 0;       ///< rod.excess_link
   double salt_M = 0;         ///< solvent.salt_M
   bool closed = true;        ///< rod.closed (an open rod: no closing segment, no Wr or ΔLk)
+  /// several rods ([[rods]]): (points, closed) of each, in the state's order; empty for one rod
+  std::vector<std::pair<int, bool>> rods;
 };
 /// Reads DIR/config.toml; defaults (diameter 20 Å) for a missing file or key. A file that is not
 /// TOML throws ConfigError.
@@ -92,6 +94,7 @@ struct Analysis {
   bool stays_circular = false;  ///< |Wr| < AnalyzeOptions::circular_writhe throughout
   bool open_rod = false;        ///< no writhe in the time series (rod.closed = false): null for the
                           ///< ring's measures (stays_circular, shape, the power law)
+  bool several_rods = false;  ///< [[rods]]: the shape classes (of one closed curve) are null
   std::optional<double> kinetic_power_law_exponent;  ///< only for runs that stay circular
   std::optional<FitWindow> kinetic_power_law_fit;
 };

@@ -278,6 +278,7 @@ std::vector<fs::path> render_run(const fs::path& dir, const RenderOptions& opt, 
 
   render::Style style;
   style.closed = info.closed;
+  style.rods = info.rods;
   if (opt.colour == "along")
     style.colouring = render::Colouring::along;
   else if (opt.colour == "height")
@@ -306,8 +307,24 @@ std::vector<fs::path> render_run(const fs::path& dir, const RenderOptions& opt, 
     const auto& [file, i] = jobs[j];
     const RodFrame& f = frames[i];
     if (labels) {
-      char wr[64], lk[96];
-      if (info.closed) {
+      char wr[192], lk[96];
+      if (!info.rods.empty()) {
+        // several rods: each closed rod's writhe (an open one's twist), in order
+        std::string w;
+        std::size_t off = 0;
+        for (const auto& [m, closed] : info.rods) {
+          const std::span<const Vec3> x = std::span<const Vec3>(f.X).subspan(off, std::size_t(m));
+          const std::span<const Vec3> d = std::span<const Vec3>(f.d1).subspan(off, std::size_t(m));
+          char one[40];
+          std::snprintf(one, sizeof one, "%s%s = %.3f", w.empty() ? "" : "  ",
+                        closed ? "Wr" : "Tw",
+                        closed ? diagnostics::writhe(x) : diagnostics::twist_open(x, d));
+          w += one;
+          off += std::size_t(m);
+        }
+        std::snprintf(wr, sizeof wr, "%s", w.substr(0, sizeof wr - 1).c_str());
+        std::snprintf(lk, sizeof lk, "%zu rods   Cs = %g M", info.rods.size(), info.salt_M);
+      } else if (info.closed) {
         std::snprintf(wr, sizeof wr, "Wr = %.3f", diagnostics::writhe(f.X));
         std::snprintf(lk, sizeof lk, "ΔLk = %d   Cs = %g M", info.excess_link, info.salt_M);
       } else {  // an open rod: no writhe or link, its twist (docs/model.md "Open rods")

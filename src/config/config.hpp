@@ -65,6 +65,12 @@ struct Config {
   std::string rod_intrinsic_file;  ///< rod.intrinsic_file: "" or a CSV of per-link Ω¹₀, Ω²₀, Ω³₀
   std::string rod_moduli_file;  ///< rod.moduli_file: "" or a CSV of per-link a1 a2 a3, b1 b2 b3
   bool rod_closed = true;       ///< rod.closed: a closed ring, or an open rod with free ends
+  std::vector<double> rod_rotation_deg{0.0, 0.0, 0.0};  ///< rod.rotation_deg: about x, y, z, °
+  std::vector<double> rod_offset_A{0.0, 0.0, 0.0};      ///< rod.offset_A: centre − box centre, Å
+  /// [[rods]] (docs/config.md "Several rods"): one table per rod, each a list of (rod key without
+  /// "rod.", its value as TOML text) set on top of the [rod] keys; empty: one rod, [rod] itself.
+  /// rod_config() resolves a table into the Config of that rod.
+  std::vector<std::vector<std::pair<std::string, std::string>>> rods;
   // [solvent]
   double solvent_salt_M = 0.1;  ///< Cs, mol/L
   double solvent_viscosity_poise = 0.01;
@@ -110,12 +116,22 @@ struct Config {
 /// 0: no trajectory.
 std::int64_t frame_every(const Config& c);
 
+/// The number of rods: the [[rods]] tables, or 1 without any.
+int rod_count(const Config& c);
+/// Rod r's configuration: c with the keys of [[rods]] table r set on top of [rod] (and no
+/// [[rods]] of its own); c itself (rods cleared) for r = 0 without [[rods]]. Throws ConfigError
+/// naming the table for a key it does not accept.
+Config rod_config(const Config& c, int r);
+/// Points of all rods together.
+int point_count(const Config& c);
+
 /// Parse a TOML document (file contents) on top of the defaults.
 void apply_toml(Config& c, const std::string& toml_text, const std::string& source_name);
 /// Load a TOML file on top of the defaults (an empty path: defaults only).
 Config load_config(const std::string& path);
 /// Apply one `section.key=value` override; value is TOML (numbers, true/false, [arrays],
-/// "strings").
+/// "strings"). `rods.K.key=value` sets a key of [[rods]] table K (from 0; K = the number of
+/// tables appends one).
 void apply_override(Config& c, const std::string& assignment);
 /// Cross-key checks (ring fits in the box, kernel fits in the grid, …); throws ConfigError.
 void validate(const Config& c);

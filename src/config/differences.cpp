@@ -28,6 +28,19 @@ std::string config_differences(const std::string& old_toml, const Config& now,
     out += (out.empty() ? "" : "; ") + la.substr(0, eq) + ": " + la.substr(eq + 3) + " → " +
            lb.substr(lb.find(" = ") + 3);
   }
+  // [[rods]] keys one side has and the other not (their lines come last)
+  auto rest = [&](std::istringstream& in, std::string line, bool old_side) {
+    while (!line.empty()) {
+      line = strip(line);
+      while (!line.empty() && line.back() == ' ') line.pop_back();
+      const auto eq = line.find(" = ");
+      out += (out.empty() ? "" : "; ") + line.substr(0, eq) + ": " +
+             (old_side ? line.substr(eq + 3) + " → (none)" : "(none) → " + line.substr(eq + 3));
+      if (!std::getline(in, line)) break;
+    }
+  };
+  if (a && !la.empty() && b.eof()) rest(a, la, true);
+  if (b && std::getline(b, lb)) rest(b, lb, false);
   return out;
 }
 

@@ -13,6 +13,7 @@
 #include "core/units.hpp"
 #include "interactions/interactions.hpp"
 #include "rod/rod.hpp"
+#include "rod/rod_set.hpp"
 
 // From the user's configuration (user units) to the simulation's parameters (internal units):
 // the cross-key checks, the conversion and the derived quantities of `ibrod check`.
@@ -21,7 +22,31 @@ namespace ibrod::config {
 using detail::bad;
 using detail::fmt;
 
+namespace {
+void validate_one(const Config& c);
+}
+
 void validate(const Config& c) {
+  if (c.rods.empty()) {
+    validate_one(c);
+    return;
+  }
+  // several rods (docs/config.md "Several rods"): each rod as if alone, then what they share
+  for (int r = 0; r < rod_count(c); ++r) {
+    try {
+      validate_one(rod_config(c, r));
+    } catch (const ConfigError& e) {
+      throw ConfigError("[[rods]] table " + std::to_string(r) + ": " + e.what());
+    }
+  }
+  if (c.time_scheme == "implicit")
+    bad("time.scheme", "\"implicit\"",
+        "\"explicit\" with several rods ([[rods]]; the implicit scheme's local solve is one "
+        "rod's; docs/model.md \"Several rods\")");
+}
+
+namespace {
+void validate_one(const Config& c) {
   if (c.grid_n % 2 != 0)
     bad("grid.n", std::to_string(c.grid_n), "an even integer >= 8 (real-to-complex FFT grid)");
   if (4 * c.grid_kernel_width + 2 > c.grid_n)
@@ -121,7 +146,17 @@ void validate(const Config& c) {
     bad("rod.excess_link", std::to_string(c.rod_excess_link),
         "a link small enough that the twisted circle exists (|sin β| = " + fmt(std::abs(sin_beta)) +
             " >= 1)");
+  // rod.rotation_deg and rod.offset_A place the built-in shapes only
+  const bool placed = std::any_of(c.rod_rotation_deg.begin(), c.rod_rotation_deg.end(),
+                                  [](double v) { return v != 0; }) ||
+                      std::any_of(c.rod_offset_A.begin(), c.rod_offset_A.end(),
+                                  [](double v) { return v != 0; });
+  if (placed && !c.rod_initial_shape.empty())
+    bad("rod.initial_shape", "\"" + c.rod_initial_shape + "\"",
+        "\"\" when rod.rotation_deg or rod.offset_A is set (they place the circle or the straight "
+        "rod; a shape from a file is used where it lies)");
 }
+}  // namespace
 
 namespace {
 
@@ -202,6 +237,62 @@ std::pair<std::vector<Vec3>, std::vector<Vec3>> read_moduli_file(const std::stri
   return out;
 }
 
+namespace {
+// One rod's parameters in internal units (a rod's Config: rod_config for [[rods]]).
+rod::RodParams rod_params(const Config& c) {
+  using namespace units;
+  rod::RodParams r;
+  r.n = c.rod_base_pairs;
+  r.ds = c.rod_rise_A * angstrom;
+  const double a = c.rod_bend_modulus_erg_cm * erg_cm;
+  r.a = Vec3(a, a, c.rod_twist_modulus_erg_cm * erg_cm);
+  const double b = c.rod_shear_modulus_dyn * dyn;
+  r.b = Vec3(b, b, c.rod_stretch_modulus_dyn * dyn);
+  r.omega0 = Vec3(c.rod_intrinsic_curvature_per_A[0], c.rod_intrinsic_curvature_per_A[1],
+                  c.rod_intrinsic_twist_per_A);
+  r.omega0_k = read_intrinsic_file(c.rod_intrinsic_file, c.rod_base_pairs);
+  for (std::size_t k = 0; k < r.omega0_k.size(); ++k)  // the scalar keys' bound, per row
+    if (r.omega0_k[k].cwiseAbs().maxCoeff() * c.rod_rise_A > kMaxTwistPerSegment)
+      bad("rod.intrinsic_file", c.rod_intrinsic_file,
+          "|Ω¹₀|, |Ω²₀|, |Ω³₀| <= π / (2 rod.rise_A) = " + fmt(kMaxTwistPerSegment / c.rod_rise_A) +
+              " rad/Å in every row (a bend or twist of at most π/2 between neighbouring "
+              "triads), but row " +
+              std::to_string(k + 1) + " exceeds it");
+  r.closed = c.rod_closed;
+  std::tie(r.a_k, r.b_k) = read_moduli_file(c.rod_moduli_file, c.rod_base_pairs);
+  if (!r.a_k.empty()) {
+    // the scalars become the means over the links in use (n closed, n − 1 open): the twisted
+    // circle's tilt sin β (docs/config.md "rod.moduli_file")
+    const int m = rod::half_points(r.n, r.closed);
+    r.a = r.b = Vec3::Zero();
+    for (int k = 0; k < m; ++k) {
+      r.a += r.a_k[k] / m;
+      r.b += r.b_k[k] / m;
+    }
+    const double r0 = rod::circle_radius(c.rod_base_pairs, c.rod_rise_A);
+    const double sin_beta =
+        rod::circle_tilt_sin_beta(r.a.x(), r.a.z(), r.b.x(), r0, c.rod_excess_link);
+    if (c.rod_closed && !(std::abs(sin_beta) < 1))
+      bad("rod.excess_link", std::to_string(c.rod_excess_link),
+          "a link small enough that the twisted circle exists at the mean moduli of "
+          "rod.moduli_file = \"" +
+              c.rod_moduli_file + "\" (|sin β| = " + fmt(std::abs(sin_beta)) + " >= 1)");
+  }
+  return r;
+}
+
+// One rod's initial circle (or straight rod): its link, twist perturbation and centre, the box
+// centre moved by rod.offset_A (box edge L, Å).
+rod::CircleParams circle_params(const Config& c, double L) {
+  rod::CircleParams cp;
+  cp.excess_link = c.rod_excess_link;
+  cp.perturbation = combined_perturbation(c.rod_perturbation, c.rod_perturbation_random);
+  cp.center = Vec3::Constant(0.5 * L);
+  for (int d = 0; d < 3; ++d) cp.center[d] += c.rod_offset_A[d] * units::angstrom;
+  return cp;
+}
+}  // namespace
+
 sim::SimParams to_params(const Config& c) {
   using namespace units;
   sim::SimParams p;
@@ -214,41 +305,24 @@ sim::SimParams to_params(const Config& c) {
   p.dt = c.time_dt_ns * ns;
   s.fluid.dt = p.dt;
   s.fluid.advection = c.solvent_advection;
-  s.rod.n = c.rod_base_pairs;
-  s.rod.ds = c.rod_rise_A * angstrom;
-  const double a = c.rod_bend_modulus_erg_cm * erg_cm;
-  s.rod.a = Vec3(a, a, c.rod_twist_modulus_erg_cm * erg_cm);
-  const double b = c.rod_shear_modulus_dyn * dyn;
-  s.rod.b = Vec3(b, b, c.rod_stretch_modulus_dyn * dyn);
-  s.rod.omega0 = Vec3(c.rod_intrinsic_curvature_per_A[0], c.rod_intrinsic_curvature_per_A[1],
-                      c.rod_intrinsic_twist_per_A);
-  s.rod.omega0_k = read_intrinsic_file(c.rod_intrinsic_file, c.rod_base_pairs);
-  for (std::size_t k = 0; k < s.rod.omega0_k.size(); ++k)  // the scalar keys' bound, per row
-    if (s.rod.omega0_k[k].cwiseAbs().maxCoeff() * c.rod_rise_A > kMaxTwistPerSegment)
-      bad("rod.intrinsic_file", c.rod_intrinsic_file,
-          "|Ω¹₀|, |Ω²₀|, |Ω³₀| <= π / (2 rod.rise_A) = " + fmt(kMaxTwistPerSegment / c.rod_rise_A) +
-              " rad/Å in every row (a bend or twist of at most π/2 between neighbouring "
-              "triads), but row " +
-              std::to_string(k + 1) + " exceeds it");
-  s.rod.closed = c.rod_closed;
-  std::tie(s.rod.a_k, s.rod.b_k) = read_moduli_file(c.rod_moduli_file, c.rod_base_pairs);
-  if (!s.rod.a_k.empty()) {
-    // the scalars become the means over the links in use (n closed, n − 1 open): the twisted
-    // circle's tilt sin β (docs/config.md "rod.moduli_file")
-    const int m = rod::half_points(s.rod.n, s.rod.closed);
-    s.rod.a = s.rod.b = Vec3::Zero();
-    for (int k = 0; k < m; ++k) {
-      s.rod.a += s.rod.a_k[k] / m;
-      s.rod.b += s.rod.b_k[k] / m;
+  s.rod = rod_params(c);
+  p.circle = circle_params(c, s.grid.L);
+  p.rotation = rod::rotation_xyz_deg(
+      Vec3(c.rod_rotation_deg[0], c.rod_rotation_deg[1], c.rod_rotation_deg[2]));
+  if (!c.rods.empty()) {
+    // several rods: rod 0 above from table 0, the others after it (docs/config.md)
+    const Config c0 = rod_config(c, 0);
+    s.rod = rod_params(c0);
+    p.circle = circle_params(c0, s.grid.L);
+    p.rotation = rod::rotation_xyz_deg(
+        Vec3(c0.rod_rotation_deg[0], c0.rod_rotation_deg[1], c0.rod_rotation_deg[2]));
+    for (int r = 1; r < rod_count(c); ++r) {
+      const Config cr = rod_config(c, r);
+      s.more_rods.push_back(rod_params(cr));
+      p.more_circles.push_back(circle_params(cr, s.grid.L));
+      p.more_rotations.push_back(rod::rotation_xyz_deg(
+          Vec3(cr.rod_rotation_deg[0], cr.rod_rotation_deg[1], cr.rod_rotation_deg[2])));
     }
-    const double r0 = rod::circle_radius(c.rod_base_pairs, c.rod_rise_A);
-    const double sin_beta =
-        rod::circle_tilt_sin_beta(s.rod.a.x(), s.rod.a.z(), s.rod.b.x(), r0, c.rod_excess_link);
-    if (c.rod_closed && !(std::abs(sin_beta) < 1))
-      bad("rod.excess_link", std::to_string(c.rod_excess_link),
-          "a link small enough that the twisted circle exists at the mean moduli of "
-          "rod.moduli_file = \"" +
-              c.rod_moduli_file + "\" (|sin β| = " + fmt(std::abs(sin_beta)) + " >= 1)");
   }
   p.kT = kT(c.solvent_temperature_K);
   // MODEL (2.19–2.22): A = q²/(4π ε0 εw), κ = 0.329 √Cs
@@ -259,7 +333,7 @@ sim::SimParams to_params(const Config& c) {
   s.steric.diameter = c.steric_diameter_A;
   s.steric.stiffness = c.steric_stiffness_kT_A2 * p.kT;
   s.steric.ds = s.rod.ds;
-  s.steric.closed = c.rod_closed;
+  s.steric.closed = s.rod.closed;
   // docs/thermal.md: the random stress at kT, keyed by run.seed; the external load
   s.fluid.thermal_kT = c.solvent_thermal ? p.kT : 0.0;
   s.fluid.seed = std::uint64_t(c.run_seed);
@@ -270,10 +344,6 @@ sim::SimParams to_params(const Config& c) {
   }
   s.threads = c.run_threads;
   s.plan_measure = c.run_fftw_measure;
-  p.circle.excess_link = c.rod_excess_link;
-  p.circle.perturbation = combined_perturbation(c.rod_perturbation, c.rod_perturbation_random);
-  // the ring sits in the middle of the box
-  p.circle.center = Vec3::Constant(0.5 * s.grid.L);
   p.t_end = c.time_t_end_us * us;
   p.stop_kinetic = c.time_stop_kinetic_kT * p.kT;
   p.stability.enabled = c.time_stability_test;

@@ -419,6 +419,12 @@ const std::vector<Key>& schema() {
               "true: a closed ring; false: an open rod with two free ends, straight along x "
               "unless rod.initial_shape gives its shape (needs rod.excess_link = 0 and "
               "time.scheme = \"explicit\"; docs/model.md \"Open rods\")"),
+      vec3_key("rod.rotation_deg", &Config::rod_rotation_deg, 360.0,
+               "turn the initial circle or straight rod about its centre by these angles about "
+               "the x, then y, then z axis, degrees (not with rod.initial_shape)"),
+      vec3_key("rod.offset_A", &Config::rod_offset_A, 1e9,
+               "move the initial circle or straight rod's centre this far from the box centre, Å "
+               "(not with rod.initial_shape)"),
       real("solvent.salt_M", &Config::solvent_salt_M, 0, false, 10.0,
            "monovalent salt concentration Cs, mol/L"),
       physical("solvent.viscosity_poise", &Config::solvent_viscosity_poise, 0.01, false,
@@ -528,7 +534,67 @@ void set_key(Config& c, const std::string& name, const toml::node& n) {
   k->set(c, n);
 }
 
+std::string toml_text(const toml::node& n);
+
+// One key of a [[rods]] table: checked at once on a scratch copy (so that an error names the
+// table and the key), kept as text, and set on top of [rod] when rod_config resolves the table.
+void set_rod_key(Config& c, std::size_t r, const std::string& key, const toml::node& value) {
+  const std::string where = "[[rods]] table " + std::to_string(r) + " (rods." + std::to_string(r) +
+                            "." + key + "): ";
+  Config scratch;
+  try {
+    set_key(scratch, "rod." + key, value);
+  } catch (const ConfigError& e) {
+    throw ConfigError("config: " + where + e.what());
+  }
+  if (c.rods.size() <= r) c.rods.resize(r + 1);
+  auto& t = c.rods[r];
+  const std::string text = toml_text(value);
+  for (auto& kv : t)
+    if (kv.first == key) {
+      kv.second = text;
+      return;
+    }
+  t.emplace_back(key, text);
+  // in key order, as a TOML table reads back: a table is the same however it was written
+  std::sort(t.begin(), t.end());
+}
+
+// rods = [[rods]]: an array of tables; a file's array replaces any earlier one.
+void set_rod_tables(Config& c, const toml::node& node) {
+  const toml::array* a = node.as_array();
+  if (!a || !a->is_array_of_tables() || a->empty())
+    throw ConfigError(
+        "config: 'rods' must be an array of tables, one [[rods]] table per rod, each with keys "
+        "of [rod] (docs/config.md \"Several rods\")");
+  c.rods.clear();
+  for (std::size_t r = 0; r < a->size(); ++r) {
+    c.rods.emplace_back();
+    for (auto&& [key, value] : *a->get(r)->as_table())
+      set_rod_key(c, r, std::string(key.str()), value);
+  }
+}
+
 }  // namespace
+
+int rod_count(const Config& c) { return c.rods.empty() ? 1 : int(c.rods.size()); }
+
+Config rod_config(const Config& c, int r) {
+  Config out = c;
+  out.rods.clear();
+  if (c.rods.empty()) return out;
+  for (const auto& [key, text] : c.rods.at(std::size_t(r))) {
+    const toml::table t = toml::parse("v = " + text);
+    set_key(out, "rod." + key, *t.get("v"));
+  }
+  return out;
+}
+
+int point_count(const Config& c) {
+  int n = 0;
+  for (int r = 0; r < rod_count(c); ++r) n += rod_config(c, r).rod_base_pairs;
+  return n;
+}
 
 std::int64_t frame_every(const Config& c) {
   return c.output_frame_every_steps < 0 ? c.output_every_steps : c.output_frame_every_steps;
@@ -538,6 +604,10 @@ void apply_toml(Config& c, const std::string& text, const std::string& source) {
   const toml::table tbl = parse_toml(text, source, "config");
   for (auto&& [sec, node] : tbl) {
     const std::string s(sec.str());
+    if (s == "rods") {
+      set_rod_tables(c, node);
+      continue;
+    }
     const toml::table* t = node.as_table();
     if (!t)
       throw ConfigError("config: top-level key '" + echo(s) + "' must be a section [" + echo(s) +
@@ -560,6 +630,27 @@ void apply_override(Config& c, const std::string& assignment) {
                       "' must have the form section.key=value");
   std::string key = assignment.substr(0, eq), value = assignment.substr(eq + 1);
   while (!key.empty() && key.back() == ' ') key.pop_back();
+  // rods.K.key=value: a key of [[rods]] table K
+  if (key.rfind("rods.", 0) == 0) {
+    const std::string rest = key.substr(5);
+    const auto dot = rest.find('.');
+    std::size_t r = 0;
+    const auto [end, ec] = std::from_chars(rest.data(), rest.data() + std::min(dot, rest.size()), r);
+    if (dot == std::string::npos || ec != std::errc() || end != rest.data() + dot ||
+        r > c.rods.size())
+      throw ConfigError("config: --set " + echo(key) +
+                        ": a [[rods]] key is rods.K.key with K a table number from 0 to " +
+                        std::to_string(c.rods.size()) + " (" + std::to_string(c.rods.size()) +
+                        " appends a table)");
+    toml::table t;  // the value parsed as any other, then kept as the table's
+    try {
+      t = toml::parse("v = " + value, "--set " + key);
+    } catch (const toml::parse_error&) {
+      t = toml::parse("v = \"" + value + "\"", "--set " + key);
+    }
+    set_rod_key(c, r, rest.substr(dot + 1), *t.get("v"));
+    return;
+  }
   // One line, one value: a newline would let TOML read (and this function drop) a second key.
   for (const char ch : assignment)
     if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f)
@@ -644,6 +735,11 @@ std::string to_toml(const Config& c) {
     if (line.size() < 32) line.resize(32, ' ');
     os << line << " # " << k.help << "\n";
   }
+  // [[rods]]: each table's own keys, on top of [rod]
+  for (const auto& t : c.rods) {
+    os << "\n[[rods]]\n";
+    for (const auto& [key, text] : t) os << key << " = " << text << "\n";
+  }
   return os.str();
 }
 
@@ -654,6 +750,12 @@ std::string describe(const Config& c) {
     if (lhs.size() < 44) lhs.resize(44, ' ');
     os << lhs << " # " << k.help << "\n";
   }
+  for (std::size_t r = 0; r < c.rods.size(); ++r)
+    for (const auto& [key, text] : c.rods[r]) {
+      std::string lhs = "rods." + std::to_string(r) + "." + key + " = " + text;
+      if (lhs.size() < 44) lhs.resize(44, ' ');
+      os << lhs << " # [[rods]] table " << r << " (on top of [rod])\n";
+    }
   return os.str();
 }
 

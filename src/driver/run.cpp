@@ -91,6 +91,25 @@ void Run::State::build_simulation() {
     sim->set_rod_state(std::move(*initial_shape));  // checked in Run::Run
     initial_shape.reset();
   }
+  const bool any_shape =
+      std::any_of(rod_shapes.begin(), rod_shapes.end(), [](const auto& r) { return bool(r); });
+  if (any_shape && !checkpoint) {
+    // several rods: each rod with rod.initial_shape takes its shape from its file, in its range
+    rod::RodState whole = sim->rod();
+    for (std::size_t r = 0; r < rod_shapes.size(); ++r) {
+      if (!rod_shapes[r]) continue;
+      const rod::RodRange& g = sim->rod_ranges()[r];
+      for (int k = 0; k < g.n; ++k) {
+        whole.X[g.offset + k] = rod_shapes[r]->X[k];
+        whole.D[g.offset + k] = rod_shapes[r]->D[k];
+      }
+    }
+    sim->set_rod_state(std::move(whole), "rod.initial_shape");
+    rod_shapes.clear();
+  }
+  if (sim->rods().size() > 1 && !checkpoint)
+    if (const std::string bad = sim->start_problem(); !bad.empty())
+      throw ConfigError("[[rods]]: the initial state: " + bad);
   // distributed: rank 0 holds every rank's plans (fftw_mpi_gather_wisdom)
   on_disk([&] {
     const std::string wisdom = fluid::wisdom_text();
@@ -116,7 +135,7 @@ void Run::State::open_files() {
   const std::uintmax_t n = std::uintmax_t(c.grid_n);
   reserve_bytes =
       24 * n * n * n +
-      4 * (300u * std::uintmax_t(c.rod_base_pairs) + (c.output_fluid_vti ? 48u * n * n * n : 0u)) +
+      4 * (300u * std::uintmax_t(config::point_count(c)) + (c.output_fluid_vti ? 48u * n * n * n : 0u)) +
       (std::uintmax_t(16) << 20);
 }
 
@@ -132,9 +151,13 @@ void Run::State::announce() {
                   static_cast<long long>(p.output.checkpoints));
   else
     std::snprintf(buf, sizeof buf,
-                  "ibrod: %lld steps of %.4g ns on %d³, %d rod points, ΔLk = %d, %d threads -> %s",
+                  "ibrod: %lld steps of %.4g ns on %d³, %d rod points%s, ΔLk = %d, %d threads -> %s",
                   static_cast<long long>(sim->end_step()), sim->dt() / 1e-9, p.stepper.grid.n,
-                  p.stepper.rod.n, p.circle.excess_link, meta.threads, dir.root().c_str());
+                  sim->rod().size(),
+                  sim->rods().size() > 1
+                      ? (" in " + std::to_string(sim->rods().size()) + " rods").c_str()
+                      : "",
+                  p.circle.excess_link, meta.threads, dir.root().c_str());
   say(buf);
   if (distributed)
     say("ibrod: the fluid grid is split over " + std::to_string(opt.ranks) + " MPI ranks (" +
@@ -211,7 +234,8 @@ void Run::State::finish(const sim::Observables& o, const std::string& stop_reaso
   std::array<const double*, 3> u{};
   if (npy) u = sim->stepper().whole_velocity(gathered);
   on_disk([&] {
-    if (error.empty()) io::write_file_atomic(dir.final_state(), io::final_state_csv(sim->rod()));
+    if (error.empty())
+      io::write_file_atomic(dir.final_state(), io::final_state_csv(sim->rod(), sim->rod_ranges()));
     if (npy) io::write_velocity_npy(dir.velocity(), c.grid_n, u[0], u[1], u[2]);
     io::write_file_atomic(dir.summary(),
                           summary_json(user, r, meta, files->frames(), stop_reason, error));
@@ -279,9 +303,7 @@ StopReason Run::State::test_stability(StopReason candidate) {
   say("ibrod: stability test at step " + std::to_string(o.step) + ": " + sim::describe(o) +
       (o.stable ? "; an equilibrium" : "; not an equilibrium, the run goes on from there"));
   if (o.stable) return candidate;
-  if (const std::string bad = sim::rod_problem(s.rod(), c.rod_rise_A, 0.5, c.rod_closed);
-      !bad.empty())
-    blow_up(bad);
+  if (const std::string bad = s.state_check(); !bad.empty()) blow_up(bad);
   last_row = observe_checked();
   record_row();
   check_link(last_row);
@@ -289,20 +311,39 @@ StopReason Run::State::test_stability(StopReason candidate) {
 }
 
 void Run::State::check_link(const sim::Observables& o) {
-  if (!c.rod_closed) return;  // an open rod has no linking number to conserve
-  const double drift = std::abs(o.link - result.initial.link);
+  double drift = 0;
+  if (o.rods.empty()) {
+    if (!c.rod_closed) return;  // an open rod has no linking number to conserve
+    drift = std::abs(o.link - result.initial.link);
+  } else {
+    // several rods: each closed rod's own link (a passage between two rings changes neither)
+    bool any = false;
+    for (std::size_t r = 0; r < o.rods.size() && r < result.initial.rods.size(); ++r)
+      if (std::isfinite(o.rods[r].link)) {
+        any = true;
+        drift = std::max(drift, std::abs(o.rods[r].link - result.initial.rods[r].link));
+      }
+    // and each pair's linking number: one rod passing through another changes it
+    for (std::size_t q = 0; q < o.pair_links.size() && q < result.initial.pair_links.size(); ++q) {
+      any = true;
+      drift = std::max(drift, std::abs(o.pair_links[q] - result.initial.pair_links[q]));
+    }
+    if (!any) return;
+  }
   meta.max_link_drift = std::max(meta.max_link_drift, drift);
   if (drift > kLinkDriftWarning && !meta.self_passage_warning) {
     meta.self_passage_warning = true;
     meta.self_passage_step = o.step;
-    char buf[320];
+    char buf[420];
     std::snprintf(buf, sizeof buf,
                   "ibrod: warning: at step %lld the linking number Lk = %.4f drifted by %.3g from "
-                  "its initial %.4f (more than %.1f): the rod has probably passed through "
-                  "itself (steric.stiffness or steric.diameter_A too small, or Δt too large); "
-                  "recorded in summary.json",
+                  "its initial %.4f (more than %.1f): %s (steric.stiffness or steric.diameter_A "
+                  "too small, or Δt too large); recorded in summary.json",
                   static_cast<long long>(o.step), o.link, o.link - result.initial.link,
-                  result.initial.link, kLinkDriftWarning);
+                  result.initial.link, kLinkDriftWarning,
+                  o.rods.empty() ? "the rod has probably passed through itself"
+                                 : "a rod has probably passed through itself or another rod "
+                                   "(rods.csv: each rod's link and each pair's)");
     say(buf);
   }
 }
@@ -313,14 +354,12 @@ RunResult Run::State::loop(const std::function<int()>& pending, std::int64_t max
   loop_start = Clock::now();
   start_step = s.step_count();
   result.signal = 0;
-  const double ds = c.rod_rise_A;
-  // docs/thermal.md: with noise a segment's thermal stretch alone may pass 50 %
-  const double tol =
-      sim::spacing_tolerance(s.params().stepper.rod, s.params().stepper.fluid.thermal_kT);
+  // (Simulation::state_check: each rod's spacing, with thermal noise the tolerance widened to
+  // what a segment's thermal stretch alone may reach; docs/thermal.md)
   try {
     ensure_space();
     if (!begun && result.resumed_from < 0) {
-      if (const std::string bad = sim::rod_problem(s.rod(), ds, tol, c.rod_closed); !bad.empty())
+      if (const std::string bad = s.state_check(); !bad.empty())
         blow_up("the initial state is not sane: " + bad);
       last_row = observe_checked();
       result.initial = meta.initial = last_row;
@@ -362,8 +401,7 @@ RunResult Run::State::loop(const std::function<int()>& pending, std::int64_t max
       }
       s.step();
       ++done;
-      if (const std::string bad = sim::rod_problem(s.rod(), ds, tol, c.rod_closed); !bad.empty())
-        blow_up(bad);
+      if (const std::string bad = s.state_check(); !bad.empty()) blow_up(bad);
       const bool segment_end = max_steps > 0 && done >= max_steps;
       const bool output_step = s.output_due() || segment_end;
       if (output_step) {
@@ -446,7 +484,24 @@ Run::Run(const config::Config& c, const RunOptions& opt) {
   config::validate(c);
   s_ = std::make_unique<State>(c, opt);
   // rod.initial_shape: read and checked before anything is written (a resumed run has its state)
-  if (!c.rod_initial_shape.empty() && !opt.resume) {
+  // several rods: each [[rods]] table's own rod.initial_shape (rod r of a file of several rods)
+  if (!c.rods.empty() && !opt.resume) {
+    for (int r = 0; r < config::rod_count(c); ++r) {
+      const config::Config cr = config::rod_config(c, r);
+      s_->rod_shapes.emplace_back();
+      if (cr.rod_initial_shape.empty()) continue;
+      const std::string key = "rods." + std::to_string(r) + ".initial_shape";
+      rod::RodState shape = io::read_rod_shape(cr.rod_initial_shape, key, r);
+      if (const std::string bad =
+              sim::state_problem(shape, cr.rod_base_pairs, cr.rod_rise_A, cr.rod_closed);
+          !bad.empty())
+        throw ConfigError(key + " = '" + cr.rod_initial_shape + "': " + bad +
+                          " (rod.base_pairs = " + std::to_string(cr.rod_base_pairs) +
+                          ", rod.rise_A = " + format_g(cr.rod_rise_A) + " Å)");
+      s_->rod_shapes.back() = std::move(shape);
+    }
+  }
+  if (c.rods.empty() && !c.rod_initial_shape.empty() && !opt.resume) {
     const std::string key = "rod.initial_shape";
     rod::RodState shape = io::read_rod_shape(c.rod_initial_shape, key);
     const std::string what = key + " = '" + c.rod_initial_shape + "'";

@@ -47,19 +47,34 @@ class RunFiles {
            std::int64_t frame_step = -1)
       : dir_(dir),
         ds_(c.rod_rise_A),
+        ranges_(sim.rod_ranges()),
         vti_(c.output_fluid_vti),
         frames_on_(sim.params().output.frames > 0),
         rod_pvd_(dir.root(), io::RunDir::kRodSeries, "vtp"),
         fluid_pvd_(dir.root(), io::RunDir::kFluidSeries, "vti") {
     const std::filesystem::path ts = dir.timeseries();
     const int n = sim.rod().size();
+    for (const rod::RodParams& r : sim.rods()) rod_ds_.push_back(r.ds);
+    const bool several = sim.rods().size() > 1;
+    std::vector<bool> closed;
+    for (const rod::RodParams& r : sim.rods()) closed.push_back(r.closed);
+    const std::string rods_header = io::rods_header(closed);
     if (resume_step < 0) {
       io::write_file_atomic(ts, io::timeseries_header() + "\n");
-      if (frames_on_) h5_ = io::H5mdWriter::create(dir.trajectory(), n, c.grid_box_A, config_text);
+      if (several) io::write_file_atomic(dir.rods(), rods_header + "\n");
+      std::vector<int> species;  // several rods: each point's rod
+      for (std::size_t r = 0; several && r < ranges_.size(); ++r)
+        species.insert(species.end(), std::size_t(ranges_[r].n), int(r));
+      if (frames_on_)
+        h5_ = io::H5mdWriter::create(dir.trajectory(), n, c.grid_box_A, config_text, species);
     } else {
       io::write_file_atomic(
           ts, io::timeseries_up_to(try_read_text_file(ts).value_or(""), io::timeseries_header(),
                                    resume_step, ts.string()));
+      if (several)
+        io::write_file_atomic(dir.rods(), io::timeseries_up_to(
+                                              try_read_text_file(dir.rods()).value_or(""),
+                                              rods_header, resume_step, dir.rods().string()));
       if (frame_step < 0) frame_step = resume_step;
       if (frames_on_)
         reopen_trajectory(dir.trajectory(), n, c.grid_box_A, frame_step, config_text, progress);
@@ -69,9 +84,16 @@ class RunFiles {
     ts_ = std::fopen(ts.c_str(), "a");
     if (!ts_)
       throw RunError("output: cannot open " + ts.string() + ": " + io::io_error_text(errno));
+    if (several) {
+      rods_ = std::fopen(dir.rods().c_str(), "a");
+      if (!rods_)
+        throw RunError("output: cannot open " + dir.rods().string() + ": " +
+                       io::io_error_text(errno));
+    }
   }
   ~RunFiles() {
     if (ts_) std::fclose(ts_);
+    if (rods_) std::fclose(rods_);
   }
   RunFiles(const RunFiles&) = delete;
   RunFiles& operator=(const RunFiles&) = delete;
@@ -101,6 +123,10 @@ class RunFiles {
     if (std::fprintf(ts_, "%s\n", io::timeseries_row(o).c_str()) < 0 || std::fflush(ts_) != 0)
       throw RunError("output: cannot write " + dir_.timeseries().string() + ": " +
                      io::io_error_text(errno));
+    if (rods_ && (std::fprintf(rods_, "%s\n", io::rods_row(o).c_str()) < 0 ||
+                  std::fflush(rods_) != 0))
+      throw RunError("output: cannot write " + dir_.rods().string() + ": " +
+                     io::io_error_text(errno));
     if (h5_) h5_->write_observables(o);
   }
 
@@ -110,7 +136,9 @@ class RunFiles {
     const double t_us = sim.time() / 1e-6;
     h5_->write_frame(sim.step_count(), t_us, sim.rod());
     rod_pvd_.add(sim.step_count(), t_us,
-                 io::rod_vtp(sim.rod(), ds_, sim.params().stepper.rod.closed));
+                 ranges_.size() > 1
+                     ? io::rod_vtp(sim.rod(), rod_ds_, ranges_)
+                     : io::rod_vtp(sim.rod(), ds_, sim.params().stepper.rod.closed));
     if (vti_) fluid_pvd_.add(sim.step_count(), t_us, io::fluid_vti(sim.params().stepper.grid, u));
   }
 
@@ -119,8 +147,11 @@ class RunFiles {
  private:
   io::RunDir dir_;
   double ds_;
+  std::vector<rod::RodRange> ranges_;
+  std::vector<double> rod_ds_;  // each rod's Δs, Å
   bool vti_, frames_on_;
   std::FILE* ts_ = nullptr;
+  std::FILE* rods_ = nullptr;  // rods.csv (several rods)
   std::unique_ptr<io::H5mdWriter> h5_;
   io::PvdSeries rod_pvd_, fluid_pvd_;
 

@@ -64,6 +64,7 @@ struct Run::State {
   std::uintmax_t reserve_bytes = 0;
   sim::Observables last_row;                   // the row of the latest output step
   std::optional<rod::RodState> initial_shape;  // rod.initial_shape, read and checked up front
+  std::vector<std::optional<rod::RodState>> rod_shapes;  // several rods: each table's, or none
   bool begun = false;                  // the first segment's step 0 (or the resumed row) is done
   std::vector<sim::Observables> rows;  // opt.keep_rows
 

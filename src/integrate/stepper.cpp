@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <array>
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 namespace ibrod::integrate {
@@ -35,24 +36,58 @@ ib::XSlab slab_of(const GridSpec& grid, const fluid::DistributedFluid* d) {
   return d ? ib::XSlab{d->x_begin(), d->x_count()} : ib::XSlab{0, grid.n};
 }
 
-// the hard core follows the rod: closed (cyclic segments) or open
+// the hard core follows the rod: closed (cyclic segments) or open; with several rods, each its own
 interactions::StericParams steric_of(const StepperParams& p) {
   interactions::StericParams s = p.steric;
   s.closed = p.rod.closed;
+  if (!p.more_rods.empty())
+    for (const rod::RodParams& r : all_rods(p)) {
+      const int offset = s.chains.empty() ? 0 : s.chains.back().offset + s.chains.back().n;
+      s.chains.push_back({offset, r.n, r.ds, r.closed});
+    }
   return s;
 }
 }  // namespace
+
+std::vector<rod::RodParams> all_rods(const StepperParams& p) {
+  std::vector<rod::RodParams> r{p.rod};
+  r.insert(r.end(), p.more_rods.begin(), p.more_rods.end());
+  return r;
+}
+
+int point_count(const StepperParams& p) {
+  int n = p.rod.n;
+  for (const rod::RodParams& r : p.more_rods) n += r.n;
+  return n;
+}
 
 Stepper::Stepper(const StepperParams& p)
     : p_((set_threads(p.threads), p)),
       fluid_(make_serial(p)),
       dist_(make_distributed(p)),
       coupler_(p.grid, p.kernel_width, slab_of(p.grid, dist_.get())),
-      plane_coupler_(coupler_, p.thermal_drift ? 3 * p.rod.n : p.rod.n),
-      electro_(p.electro, p.rod.n),
-      steric_(steric_of(p), p.rod.n) {
-  const int n = p.rod.n;
-  work_.resize(n);
+      plane_coupler_(coupler_, p.thermal_drift ? 3 * point_count(p) : point_count(p)),
+      electro_(p.electro, point_count(p)),
+      steric_(steric_of(p), point_count(p)) {
+  const int n = point_count(p);
+  if (p.more_rods.empty()) {
+    work_.resize(n);
+  } else {
+    rods_ = all_rods(p);
+    ranges_ = rod::ranges_of(rods_);
+    const std::size_t R = rods_.size();
+    rod_state_.resize(R);
+    rod_work_.resize(R);
+    rod_F_.resize(R);
+    rod_T_.resize(R);
+    for (std::size_t r = 0; r < R; ++r) {
+      rod_state_[r].X.resize(rods_[r].n);
+      rod_state_[r].D.resize(rods_[r].n);
+      rod_work_[r].resize(rods_[r].n);
+      rod_F_[r].resize(rods_[r].n);
+      rod_T_[r].resize(rods_[r].n);
+    }
+  }
   F_.resize(n);
   T_.resize(n);
   U_.resize(n);
@@ -131,11 +166,36 @@ StepEnergies Stepper::compute_forces(const rod::RodState& s) {
   return forces(s, none);
 }
 
+rod::ElasticEnergy Stepper::elastic(const rod::RodState& s) {
+  if (rods_.empty()) return rod::elastic_forces(p_.rod, s, work_, F_, T_);
+  if (s.size() != int(F_.size()))
+    throw std::invalid_argument("Stepper: the state has " + std::to_string(s.size()) +
+                                " points, the rods " + std::to_string(F_.size()));
+  // each rod on its own points: a copy of its range, its forces added back at its offset
+  rod::ElasticEnergy e;
+  for (std::size_t r = 0; r < rods_.size(); ++r) {
+    const rod::RodRange& g = ranges_[r];
+    rod::extract(s, g, rod_state_[r]);
+    std::fill(rod_F_[r].begin(), rod_F_[r].end(), Vec3::Zero());
+    std::fill(rod_T_[r].begin(), rod_T_[r].end(), Vec3::Zero());
+    const rod::ElasticEnergy er =
+        rod::elastic_forces(rods_[r], rod_state_[r], rod_work_[r], rod_F_[r], rod_T_[r]);
+    for (int k = 0; k < g.n; ++k) {
+      F_[g.offset + k] += rod_F_[r][k];
+      T_[g.offset + k] += rod_T_[r][k];
+    }
+    e.bend += er.bend;
+    e.twist += er.twist;
+    e.stretch += er.stretch;
+  }
+  return e;
+}
+
 StepEnergies Stepper::forces(const rod::RodState& s, PhaseClock& clock) {
   std::fill(F_.begin(), F_.end(), Vec3::Zero());
   std::fill(T_.begin(), T_.end(), Vec3::Zero());
   StepEnergies e;
-  e.elastic = rod::elastic_forces(p_.rod, s, work_, F_, T_);
+  e.elastic = elastic(s);
   clock.mark(0);
   // MODEL §3 sign convention: −∂E/∂X of every non-elastic potential goes to the fluid unchanged.
   if (p_.electro.enabled) e.electro = electro_.accumulate(s.X, F_);

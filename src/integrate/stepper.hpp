@@ -29,6 +29,7 @@
 #include "ib/plane_coupler.hpp"
 #include "interactions/interactions.hpp"
 #include "rod/rod.hpp"
+#include "rod/rod_set.hpp"
 
 namespace ibrod::integrate {
 
@@ -36,7 +37,10 @@ struct StepperParams {
   GridSpec grid;
   int kernel_width = 1;  ///< c/h
   fluid::FluidParams fluid;
-  rod::RodParams rod;
+  rod::RodParams rod;  ///< the rod (with several rods, the first)
+  /// Several rods (`[[rods]]`, docs/model.md "Several rods"): the second, third, … rod, whose
+  /// points follow the first rod's in the state (rod::RodRange). Empty: one rod.
+  std::vector<rod::RodParams> more_rods;
   interactions::ElectroParams electro;
   interactions::StericParams steric;
   int threads = 0;           ///< OpenMP/FFTW threads, 0 = OpenMP default
@@ -56,6 +60,11 @@ struct StepperParams {
   /// at the midpoint Xⁿ + (Δt/2)Uⁿ⁺¹ of a predictor step
   bool thermal_drift = false;
 };
+
+/// Every rod of p, in the state's order: p.rod, then p.more_rods.
+std::vector<rod::RodParams> all_rods(const StepperParams& p);
+/// Points of all rods together (the size of the state and of every per-point buffer).
+int point_count(const StepperParams& p);
 
 /// Potential energies of the state whose forces compute_forces() evaluated, g Å² s⁻².
 struct StepEnergies {
@@ -141,6 +150,13 @@ class Stepper {
   interactions::Electrostatics electro_;
   interactions::Steric steric_;
   rod::RodWork work_;
+  // several rods: each rod's params, range, scratch copy of its state, work and F, T buffers
+  std::vector<rod::RodParams> rods_;
+  std::vector<rod::RodRange> ranges_;
+  std::vector<rod::RodState> rod_state_;
+  std::vector<rod::RodWork> rod_work_;
+  std::vector<std::vector<Vec3>> rod_F_, rod_T_;
+  rod::ElasticEnergy elastic(const rod::RodState& s);  // F_, T_ += every rod's elastic load
   // [n] point forces (g Å s⁻²), torques (g Å² s⁻²), velocities U (Å s⁻¹), angular
   // velocities W (s⁻¹)
   std::vector<Vec3> F_, T_, U_, W_;

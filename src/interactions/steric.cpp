@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <stdexcept>
+#include <string>
 
 #include "interactions/cell_list.hpp"
 #include "interactions/interactions.hpp"
@@ -78,54 +80,82 @@ double steric_pair(double D, double g, const Vec3& P0, const Vec3& P1, const Vec
   return 0.5 * g * overlap * overlap;  // MODEL (2.17)
 }
 
-namespace {
-
-/// Whether segments k and l of a rod of n points are more than 2D apart along the rod (closed:
-/// the cyclic index distance; open: |k − l|).
-inline bool far_along_rod(int k, int l, int n, const StericParams& p) {
-  const int m = std::abs(k - l);
-  return (p.closed ? std::min(m, n - m) : m) * p.ds > 2 * p.diameter;
+void Steric::build_segments(int n) const {
+  if (seg_built_for_ == n) return;
+  std::vector<Chain> chains = p_.chains;
+  if (chains.empty()) chains.push_back({0, n, p_.ds, p_.closed});
+  int count = 0;
+  for (const Chain& c : chains) {
+    if (c.offset != count || c.n < 0)
+      throw std::invalid_argument("Steric: the rods' ranges must cover the points in order");
+    count += c.n;
+  }
+  if (count != n)
+    throw std::invalid_argument("Steric: the rods have " + std::to_string(count) +
+                                " points, the state " + std::to_string(n));
+  seg_a_.clear();
+  seg_b_.clear();
+  seg_chain_.clear();
+  seg_pos_.clear();
+  for (std::size_t r = 0; r < chains.size(); ++r) {
+    const Chain& c = chains[r];
+    if (c.n < 2) continue;
+    const int ns = c.closed ? c.n : c.n - 1;  // closed: the last one X_{n−1} → X_0
+    for (int k = 0; k < ns; ++k) {
+      seg_a_.push_back(c.offset + k);
+      seg_b_.push_back(c.offset + (k + 1) % c.n);
+      seg_chain_.push_back(int(r));
+      seg_pos_.push_back(k);
+    }
+  }
+  chains_ = std::move(chains);
+  seg_built_for_ = n;
 }
 
-/// Segments of a rod of n points: n closed (the last one X_{n−1} → X_0), n − 1 open.
-inline int segments(int n, const StericParams& p) { return p.closed ? n : n - 1; }
+// Whether segments k and l are a pair: different rods always; the same rod when more than 2D
+// apart along it (closed: the cyclic index distance; open: |k − l|).
+bool Steric::far_along_rod(int k, int l) const {
+  if (seg_chain_[k] != seg_chain_[l]) return true;
+  const Chain& c = chains_[seg_chain_[k]];
+  const int m = std::abs(seg_pos_[k] - seg_pos_[l]);
+  return (c.closed ? std::min(m, c.n - m) : m) * c.ds > 2 * p_.diameter;
+}
 
-/// Segment pair k, l: adds the forces on X_k, X_{k+1}, X_l, X_{l+1} into F (indexed by point);
-/// returns the energy.
-inline double segment_pair(const StericParams& p, std::span<const Vec3> X, int k, int l, Vec3* F) {
-  const int n = int(X.size());
-  const int k1 = (k + 1) % n, l1 = (l + 1) % n;
+// Segment pair k, l: adds the forces on their end points into F (indexed by point); returns the
+// energy.
+double Steric::segment_pair(std::span<const Vec3> X, int k, int l, Vec3* F) const {
+  const int k0 = seg_a_[k], k1 = seg_b_[k], l0 = seg_a_[l], l1 = seg_b_[l];
   std::array<Vec3, 4> f;
-  const double E = steric_pair(p.diameter, p.stiffness, X[k], X[k1], X[l], X[l1], f);
+  const double E = steric_pair(p_.diameter, p_.stiffness, X[k0], X[k1], X[l0], X[l1], f);
   if (E > 0) {
-    F[k] += f[0];
+    F[k0] += f[0];
     F[k1] += f[1];
-    F[l] += f[2];
+    F[l0] += f[2];
     F[l1] += f[3];
   }
   return E;
 }
-
-}  // namespace
 
 Steric::Steric(const StericParams& p, int n) : p_(p) {
   cells_.order.reserve(n);
   cells_.cell.reserve(n);
   cells_.x.reserve(n);
   mid_.reserve(n);
+  build_segments(n);
 }
 
 double Steric::accumulate(std::span<const Vec3> X, std::span<Vec3> F) {
   used_cells_ = false;
   const int n = int(X.size());
   if (!p_.enabled || n < 2 || !(p_.diameter > 0)) return 0;
+  build_segments(n);
   // midpoints and the longest segment: closest distance < D ⇒ midpoints < D + L_max apart
-  const int ns = segments(n, p_);
+  const int ns = int(seg_a_.size());
   mid_.resize(ns);
   double lmax2 = 0;
   for (int k = 0; k < ns; ++k) {
-    const Vec3& a = X[k];
-    const Vec3& b = X[(k + 1) % n];
+    const Vec3& a = X[seg_a_[k]];
+    const Vec3& b = X[seg_b_[k]];
     mid_[k] = 0.5 * (a + b);
     lmax2 = std::max(lmax2, (b - a).squaredNorm());
   }
@@ -133,24 +163,23 @@ double Steric::accumulate(std::span<const Vec3> X, std::span<Vec3> F) {
   const double reach2 = reach * reach;
   const detail::CellGrid g = detail::make_grid(mid_, reach, 4 * ns + 64);
   used_cells_ = !g.trivial();
-  const StericParams p = p_;
   if (!used_cells_) {
-    // the loop runs over n (the force buffers' size); an open rod's point n−1 starts no segment
+    // the loop runs over n (the force buffers' size); segments number at most n
     return detail::parallel_pairs(n, F, thread_F_, thread_E_, [&](int k, Vec3* Ft, double& E) {
       for (int l = k + 1; l < ns; ++l)
-        if ((mid_[k] - mid_[l]).squaredNorm() < reach2 && far_along_rod(k, l, n, p))
-          E += segment_pair(p, X, k, l, Ft);
+        if ((mid_[k] - mid_[l]).squaredNorm() < reach2 && far_along_rod(k, l))
+          E += segment_pair(X, k, l, Ft);
     });
   }
   detail::bin(g, mid_, cells_);
   const detail::CellScratch& c = cells_;
   return detail::parallel_pairs(n, F, thread_F_, thread_E_, [&](int a, Vec3* Ft, double& E) {
-    if (a >= ns) return;  // open rod: n − 1 segments, n force slots
+    if (a >= ns) return;  // open rods: fewer segments than force slots
     const int k = c.order[a];
     detail::for_each_partner(g, c, a, [&](int b) {
       const int l = c.order[b];
-      if ((c.x[a] - c.x[b]).squaredNorm() < reach2 && far_along_rod(k, l, n, p))
-        E += segment_pair(p, X, std::min(k, l), std::max(k, l), Ft);
+      if ((c.x[a] - c.x[b]).squaredNorm() < reach2 && far_along_rod(k, l))
+        E += segment_pair(X, std::min(k, l), std::max(k, l), Ft);
     });
   });
 }
@@ -159,11 +188,12 @@ double Steric::accumulate_direct(std::span<const Vec3> X, std::span<Vec3> F) con
   if (!p_.enabled) return 0;
   const int n = int(X.size());
   if (n < 2) return 0;
+  build_segments(n);
   double E = 0;
-  const int ns = segments(n, p_);
+  const int ns = int(seg_a_.size());
   for (int k = 0; k < ns; ++k)
     for (int l = k + 1; l < ns; ++l)
-      if (far_along_rod(k, l, n, p_)) E += segment_pair(p_, X, k, l, F.data());
+      if (far_along_rod(k, l)) E += segment_pair(X, k, l, F.data());
   return E;
 }
 
@@ -171,13 +201,15 @@ double Steric::energy(std::span<const Vec3> X) const {
   if (!p_.enabled) return 0;
   const int n = int(X.size());
   if (n < 2) return 0;
+  build_segments(n);
   double E = 0;
   std::array<Vec3, 4> f;
-  const int ns = segments(n, p_);
+  const int ns = int(seg_a_.size());
   for (int k = 0; k < ns; ++k)
     for (int l = k + 1; l < ns; ++l)
-      if (far_along_rod(k, l, n, p_))
-        E += steric_pair(p_.diameter, p_.stiffness, X[k], X[(k + 1) % n], X[l], X[(l + 1) % n], f);
+      if (far_along_rod(k, l))
+        E += steric_pair(p_.diameter, p_.stiffness, X[seg_a_[k]], X[seg_b_[k]], X[seg_a_[l]],
+                         X[seg_b_[l]], f);
   return E;
 }
 

@@ -1,5 +1,7 @@
 #include "io/csv.hpp"
 
+#include <cmath>
+
 #include <algorithm>
 #include <cerrno>
 #include <cstdio>
@@ -99,6 +101,54 @@ std::string final_state_csv(const rod::RodState& s) {
     out += buf;
   }
   return out;
+}
+
+std::string final_state_csv(const rod::RodState& s, const std::vector<rod::RodRange>& ranges) {
+  if (ranges.size() <= 1) return final_state_csv(s);
+  const std::string plain = final_state_csv(s);
+  // the same lines, each after its rod's number
+  std::string out = "rod," + plain.substr(0, plain.find('\n') + 1);
+  std::size_t pos = plain.find('\n') + 1;
+  for (std::size_t r = 0; r < ranges.size(); ++r)
+    for (int k = 0; k < ranges[r].n; ++k) {
+      const std::size_t end = plain.find('\n', pos);
+      out += std::to_string(r) + "," + plain.substr(pos, end + 1 - pos);
+      pos = end + 1;
+    }
+  return out;
+}
+
+std::string rods_header(const std::vector<bool>& closed) {
+  std::string s = "step,time_us";
+  const std::size_t rods = closed.size();
+  for (std::size_t r = 0; r < rods; ++r) {
+    const std::string k = std::to_string(r);
+    s += ",writhe_" + k + ",twist_" + k + ",link_" + k;
+  }
+  for (std::size_t a = 0; a < rods; ++a)
+    for (std::size_t b = a + 1; b < rods; ++b)
+      if (closed[a] && closed[b]) s += ",link_" + std::to_string(a) + "_" + std::to_string(b);
+  return s;
+}
+
+std::string rods_row(const sim::Observables& o) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%lld,%.10g", static_cast<long long>(o.step), o.time_us);
+  std::string s = buf;
+  for (const auto& r : o.rods)
+    for (double v : {r.writhe, r.twist, r.link}) {
+      if (std::isnan(v)) {  // not defined: an open rod's writhe and link
+        s += ',';
+        continue;
+      }
+      std::snprintf(buf, sizeof buf, ",%.12g", v);
+      s += buf;
+    }
+  for (double v : o.pair_links) {
+    std::snprintf(buf, sizeof buf, ",%.12g", v);
+    s += buf;
+  }
+  return s;
 }
 
 std::string timeseries_up_to(const std::string& text, const std::string& header,

@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "rod/rod.hpp"
+#include "rod/rod_set.hpp"
+#include "sim/simulation.hpp"
 
 namespace ibrod::io {
 
@@ -36,6 +38,16 @@ bool parse_double(const std::string& s, double& v);
 /// rod point (positions and triad columns D¹, D², D³ to 17 significant digits: read back, the
 /// numbers are the state's bit for bit; rod.initial_shape starts a run from them).
 std::string final_state_csv(const rod::RodState& s);
+/// The same for several rods (rod::RodRange, in order): a first column `rod` (0, 1, …) before
+/// the others. One range: exactly final_state_csv(s).
+std::string final_state_csv(const rod::RodState& s, const std::vector<rod::RodRange>& ranges);
+
+/// rods.csv of a run of several rods (docs/outputs.md): step,time_us, then writhe_r,twist_r,link_r
+/// for r = 0 … rods − 1 (an open rod's writhe and link empty), then link_a_b, the linking number of
+/// each pair a < b of closed rods (`closed`: each rod's).
+std::string rods_header(const std::vector<bool>& closed);
+/// One row of rods.csv from a time-series row (Observables::rods), no newline.
+std::string rods_row(const sim::Observables& o);
 
 /// timeseries.csv cut back to the rows with step <= last_step, in increasing step order, after
 /// `header` (an incomplete last line — a run killed while writing it — and any row out of order

@@ -337,7 +337,8 @@ Hid file_access() {
 }  // namespace
 
 std::unique_ptr<H5mdWriter> H5mdWriter::create(const std::filesystem::path& path, int n,
-                                               double box_A, const std::string& config_toml) {
+                                               double box_A, const std::string& config_toml,
+                                               const std::vector<int>& species) {
   quiet_hdf5();
   std::unique_ptr<H5mdWriter> w(new H5mdWriter);
   w->impl_ = std::make_unique<Impl>();
@@ -377,6 +378,17 @@ std::unique_ptr<H5mdWriter> H5mdWriter::create(const std::filesystem::path& path
     for (int e2 = 0; e2 < 4; ++e2)
       m.rod[e2] =
           Impl::make(cx, rod, kElements[e2], {hsize_t(n), 3}, e2 == 0 ? kLengthUnit : nullptr);
+    if (!species.empty()) {
+      // several rods: each point's rod, time-independent (H5MD: a plain dataset)
+      const hsize_t dims[1] = {species.size()};
+      Hid space(H5Screate_simple(1, dims, nullptr), H5Sclose);
+      Hid d(cx.ok(H5Dcreate2(rod, "species", H5T_STD_I32LE, space, H5P_DEFAULT, H5P_DEFAULT,
+                             H5P_DEFAULT),
+                  "create dataset species"),
+            H5Dclose);
+      if (H5Dwrite(d, H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT, species.data()) < 0)
+        cx.fail("write dataset species");
+    }
   }
   {
     Hid obs = cx.group(m.file, "observables", true);

@@ -10,6 +10,7 @@
 //   /particles/rod/position       step [T] i64, time [T] f64 (µs), value [T, n, 3] f64 (Å,
 //                                 unwrapped: never folded into the box)
 //   /particles/rod/d1, d2, d3     step, time, value [T, n, 3]: the triad columns D¹, D², D³
+//   /particles/rod/species        [n] i32, several rods only: each point's rod (0, 1, …)
 //   /observables/<column>         step [R] i64, time [R] f64 (µs), value [R] f64, one group per
 //                                 timeseries.csv column other than step and time_us
 //   /parameters/config_toml       scalar string: config.toml of the run
@@ -32,8 +33,11 @@ namespace ibrod::io {
 class H5mdWriter {
  public:
   /// Creates `path` (replacing any file there) with the layout above and no frames.
+  /// `species` (several rods: each point's rod, n values) is written as the time-independent
+  /// /particles/rod/species [n] (int32, H5MD's element for a particle's kind); none when empty.
   static std::unique_ptr<H5mdWriter> create(const std::filesystem::path& path, int n, double box_A,
-                                            const std::string& config_toml);
+                                            const std::string& config_toml,
+                                            const std::vector<int>& species = {});
   /// Opens an existing file to continue a run: every frame and row with step > last_step is
   /// dropped, and /parameters/config_toml is set to config_toml. Throws RunError if the file
   /// cannot be opened or does not have the layout for n points.

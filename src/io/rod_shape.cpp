@@ -1,5 +1,6 @@
 #include "io/rod_shape.hpp"
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
@@ -25,7 +26,7 @@ bool split_frame(const std::string& spec, std::string& path, long long& frame) {
   return true;
 }
 
-rod::RodState from_csv(const std::string& path, const std::string& key) {
+rod::RodState from_csv(const std::string& path, const std::string& key, int rod_index) {
   const CsvTable t = read_csv_table(path);
   static const char* names[12] = {"x_A", "y_A", "z_A", "d1x", "d1y", "d1z",
                                   "d2x", "d2y", "d2z", "d3x", "d3y", "d3z"};
@@ -34,16 +35,36 @@ rod::RodState from_csv(const std::string& path, const std::string& key) {
       throw ConfigError(key + " = '" + path + "': the file has no column " + n +
                         " (expected the columns of final_state.csv: x_A,y_A,z_A,d1x,d1y,d1z,"
                         "d2x,d2y,d2z,d3x,d3y,d3z)");
-  const std::size_t n = t.rows();
+  // the rows to take: all, or a file of several rods' rows of rod `rod_index`
+  std::vector<std::size_t> rows;
+  if (t.has("rod")) {
+    const auto rod = t.column("rod");
+    double most = 0;
+    for (double v : rod) most = std::max(most, v);
+    const int want = rod_index < 0 ? 0 : rod_index;
+    if (rod_index < 0 && most > 0)
+      throw ConfigError(key + " = '" + path + "': the file holds " + std::to_string(int(most) + 1) +
+                        " rods (a run of several rods); a [[rods]] table's rod.initial_shape takes "
+                        "its own rod from it, a run of one rod cannot");
+    for (std::size_t k = 0; k < rod.size(); ++k)
+      if (rod[k] == want) rows.push_back(k);
+    if (rows.empty())
+      throw ConfigError(key + " = '" + path + "': the file has no rows of rod " +
+                        std::to_string(want) + " (it holds rods 0 to " +
+                        std::to_string(int(most)) + ")");
+  } else {
+    for (std::size_t k = 0; k < t.rows(); ++k) rows.push_back(k);
+  }
+  const std::size_t n = rows.size();
   rod::RodState s;
   s.X.resize(n);
   s.D.resize(n);
   for (int c = 0; c < 3; ++c) {
     const auto x = t.column(names[c]);
-    for (std::size_t k = 0; k < n; ++k) s.X[k][c] = x[k];
+    for (std::size_t k = 0; k < n; ++k) s.X[k][c] = x[rows[k]];
     for (int col = 0; col < 3; ++col) {
       const auto d = t.column(names[3 + 3 * col + c]);
-      for (std::size_t k = 0; k < n; ++k) s.D[k](c, col) = d[k];
+      for (std::size_t k = 0; k < n; ++k) s.D[k](c, col) = d[rows[k]];
     }
   }
   return s;
@@ -80,7 +101,7 @@ rod::RodState from_h5md(const std::string& path, long long frame, const std::str
 
 }  // namespace
 
-rod::RodState read_rod_shape(const std::string& spec, const std::string& key) {
+rod::RodState read_rod_shape(const std::string& spec, const std::string& key, int rod_index) {
   std::string path;
   long long frame = -1;
   if (split_frame(spec, path, frame)) return from_h5md(path, frame, key);
@@ -90,7 +111,7 @@ rod::RodState read_rod_shape(const std::string& spec, const std::string& key) {
   if (!std::filesystem::exists(spec, ec))
     throw ConfigError(key + " = '" + spec + "': no such file");
   try {
-    return from_csv(spec, key);
+    return from_csv(spec, key, rod_index);
   } catch (const ConfigError& err) {
     const std::string m = err.what();
     if (m.rfind(key, 0) == 0) throw;

@@ -14,6 +14,8 @@ namespace ibrod::io {
 ///                   FRAME counts from 0, a negative FRAME from the end (−1: the last frame)
 /// The numbers are returned exactly as stored (no re-orthonormalisation); the caller checks them
 /// (sim::Simulation::set_rod_state). Throws ConfigError naming `key`, the file and the reason.
-rod::RodState read_rod_shape(const std::string& spec, const std::string& key);
+/// A final_state.csv of several rods (a first column `rod`) gives the rows of rod `rod_index`;
+/// such a file read with rod_index < 0 is refused unless it holds one rod only.
+rod::RodState read_rod_shape(const std::string& spec, const std::string& key, int rod_index = -1);
 
 }  // namespace ibrod::io

@@ -27,6 +27,8 @@ class RunDir {
 
   std::filesystem::path config() const { return root_ / "config.toml"; }
   std::filesystem::path timeseries() const { return root_ / "timeseries.csv"; }
+  /// several rods: each rod's writhe, twist and link at every row (docs/outputs.md)
+  std::filesystem::path rods() const { return root_ / "rods.csv"; }
   std::filesystem::path trajectory() const { return root_ / "trajectory.h5"; }
   /// where a trajectory.h5 that cannot be reopened on resume is moved (kept for inspection)
   std::filesystem::path damaged_trajectory(std::int64_t step) const {
@@ -49,7 +51,7 @@ class RunDir {
   std::vector<std::filesystem::path> run_files() const {
     return {config(),       timeseries(), trajectory(),  root_ / "rod.pvd", root_ / "fluid.pvd",
             checkpoint(),   wisdom(),     final_state(), summary(),         velocity(),
-            root_ / kVtkDir};
+            root_ / kVtkDir, rods()};
   }
 
  private:

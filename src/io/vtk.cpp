@@ -98,6 +98,73 @@ std::string rod_vtp(const rod::RodState& s, double ds_A, bool closed) {
   return out;
 }
 
+std::string rod_vtp(const rod::RodState& s, const std::vector<double>& ds_A,
+                    const std::vector<rod::RodRange>& ranges) {
+  if (ranges.size() == 1) return rod_vtp(s, ds_A.at(0), ranges[0].closed);
+  const int n = s.size();
+  std::vector<double> omega(n), strain(n), rod_of(n);
+  std::size_t lines = 0;  // connectivity entries
+  for (std::size_t r = 0; r < ranges.size(); ++r) {
+    const rod::RodRange& g = ranges[r];
+    const double ds = ds_A.at(r);
+    std::vector<double> om(g.n), st(g.n);  // per half point k+½ of this rod
+    for (int k = 0; k < rod::half_points(g.n, g.closed); ++k) {
+      const int a = g.offset + k, b = g.offset + (k + 1 == g.n ? 0 : k + 1);
+      om[k] = twist_density(s.D[a], s.D[b], ds);
+      st[k] = (s.X[b] - s.X[a]).norm() / ds - 1.0;
+    }
+    if (!g.closed && g.n >= 2) {
+      om[g.n - 1] = om[g.n - 2];
+      st[g.n - 1] = st[g.n - 2];
+    }
+    for (int k = 0; k < g.n; ++k) {
+      omega[g.offset + k] =
+          (!g.closed && k == 0) ? om[0] : 0.5 * (om[k] + om[k == 0 ? g.n - 1 : k - 1]);
+      strain[g.offset + k] = st[k];
+      rod_of[g.offset + k] = double(r);
+    }
+    lines += std::size_t(g.n) + (g.closed ? 1 : 0);
+  }
+  std::vector<double> connectivity, offsets;
+  connectivity.reserve(lines);
+  for (const rod::RodRange& g : ranges) {
+    for (int k = 0; k < g.n; ++k) connectivity.push_back(g.offset + k);
+    if (g.closed) connectivity.push_back(g.offset);  // the first point again: a closed polyline
+    offsets.push_back(double(connectivity.size()));
+  }
+  std::string out;
+  out.reserve(std::size_t(n) * 280 + 1024);
+  out +=
+      "<?xml version=\"1.0\"?>\n"
+      "<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" "
+      "header_type=\"UInt64\">\n"
+      "  <PolyData>\n";
+  out += "    <Piece NumberOfPoints=\"" + std::to_string(n) +
+         "\" NumberOfVerts=\"0\" NumberOfLines=\"" + std::to_string(ranges.size()) +
+         "\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n";
+  out += "      <PointData Scalars=\"twist_density_rad_per_A\" Vectors=\"d3\">\n";
+  const char* const triad_names[3] = {"d1", "d2", "d3"};
+  for (int c = 0; c < 3; ++c)
+    data_array(out, "Float64", triad_names[c], 3, n,
+               [&](std::size_t k, int i) { return s.D[k](i, c); });
+  data_array(out, "Float64", "twist_density_rad_per_A", 1, n,
+             [&](std::size_t k, int) { return omega[k]; });
+  data_array(out, "Float64", "stretch_strain", 1, n, [&](std::size_t k, int) { return strain[k]; });
+  data_array(
+      out, "Int32", "rod", 1, n, [&](std::size_t k, int) { return rod_of[k]; }, "%.0f");
+  out += "      </PointData>\n      <Points>\n";
+  data_array(out, "Float64", "Points", 3, n, [&](std::size_t k, int i) { return s.X[k][i]; });
+  out += "      </Points>\n      <Lines>\n";
+  data_array(
+      out, "Int64", "connectivity", 1, connectivity.size(),
+      [&](std::size_t k, int) { return connectivity[k]; }, "%.0f");
+  data_array(
+      out, "Int64", "offsets", 1, offsets.size(), [&](std::size_t k, int) { return offsets[k]; },
+      "%.0f");
+  out += "      </Lines>\n    </Piece>\n  </PolyData>\n</VTKFile>\n";
+  return out;
+}
+
 std::string fluid_vti(const GridSpec& g, std::array<const double*, 3> u) {
   const int n = g.n;
   const double h = g.h();

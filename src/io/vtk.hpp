@@ -12,6 +12,7 @@
 
 #include "core/grid.hpp"
 #include "rod/rod.hpp"
+#include "rod/rod_set.hpp"
 
 namespace ibrod::io {
 
@@ -24,6 +25,11 @@ namespace ibrod::io {
 /// 0 … n−1, no closing segment); the end points' twist density is their one half point's, and
 /// the last point's stretch_strain that of the segment before it.
 std::string rod_vtp(const rod::RodState& s, double ds_A, bool closed = true);
+/// The same for several rods laid end to end (rod::RodRange, in order; each its own Δs in
+/// ds_A): one polyline cell per rod, the twist density and strain of each rod's own links, and
+/// a point array `rod` (0, 1, …) to colour them by. One range: exactly rod_vtp(s, ds, closed).
+std::string rod_vtp(const rod::RodState& s, const std::vector<double>& ds_A,
+                    const std::vector<rod::RodRange>& ranges);
 
 /// The fluid velocity as VTK XML ImageData on the grid points (origin 0, spacing h in Å), point
 /// data velocity_A_per_ns (3 components, Å/ns). u: the three components in Å/s, GridSpec::index

@@ -163,22 +163,59 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
   std::vector<float> param(style.colouring == Colouring::stripe ? 0 : depth.size(), 0.0f);
   // arc length of the nearest hit's axis point from X_0, for the outlines
   std::vector<float> arc(depth.size(), 0.0f);
-  // segments k → k+1: n of a closed polygon, n − 1 of an open one
-  const std::size_t segs = style.closed ? n : n - 1;
-  std::vector<double> cum(n + 1, 0.0);
-  for (std::size_t k = 0; k < segs; ++k) cum[k + 1] = cum[k] + (X[(k + 1) % n] - X[k]).norm();
-  const double arc_total = cum[segs];
+  // the rods: one (X, style.closed), or several laid end to end (style.rods); each point's next
+  // and previous point along its rod (−1 past a free end), its rod, and the rods' arc lengths
+  std::vector<std::pair<int, bool>> rods = style.rods;
+  if (rods.empty()) rods.push_back({int(n), style.closed});
+  {
+    std::size_t total = 0;
+    for (const auto& [m, c] : rods) total += std::size_t(m);
+    if (total != n) throw std::invalid_argument("render_rod: the rods' points are not X's");
+  }
+  std::vector<long> next(n, -1), prev(n, -1);
+  std::vector<int> rod_of(n, 0);
+  std::vector<double> rod_len(rods.size(), 0.0);
+  std::vector<bool> rod_closed(rods.size());
+  {
+    std::size_t off = 0;
+    for (std::size_t r = 0; r < rods.size(); ++r) {
+      const std::size_t m = std::size_t(rods[r].first);
+      rod_closed[r] = rods[r].second;
+      for (std::size_t k = 0; k < m; ++k) {
+        rod_of[off + k] = int(r);
+        if (k + 1 < m || rods[r].second) next[off + k] = long(off + (k + 1) % m);
+        if (k > 0 || rods[r].second) prev[off + k] = long(off + (k + m - 1) % m);
+      }
+      off += m;
+    }
+  }
+  // segments k → next[k]: n of a closed polygon, n − 1 of an open one, per rod
+  std::vector<std::size_t> seg;
+  for (std::size_t k = 0; k < n; ++k)
+    if (next[k] >= 0) seg.push_back(k);
+  // cum[k]: arc length from its rod's first point to point k
+  std::vector<double> cum(n, 0.0);
+  for (std::size_t k = 0; k < n; ++k) {
+    const double len = next[k] >= 0 ? (X[std::size_t(next[k])] - X[k]).norm() : 0.0;
+    rod_len[rod_of[k]] += len;
+    if (next[k] > long(k)) cum[std::size_t(next[k])] = cum[k] + len;
+  }
   double z_lo = std::numeric_limits<double>::infinity(), z_hi = -z_lo;
   // twist colouring: the twist density at each point (mean of its two segments), mapped from
   // the frame's lowest (0) to its highest (1); uniform twist: the middle of the map
   std::vector<double> tw_point;
   if (style.colouring == Colouring::twist) {
-    const auto tw = twist_density(X, d1);
     tw_point.resize(n);
-    for (std::size_t k = 0; k < n; ++k) tw_point[k] = 0.5 * (tw[(k + n - 1) % n] + tw[k]);
-    if (!style.closed) {  // the ends have one segment each
-      tw_point[0] = tw[0];
-      tw_point[n - 1] = tw[n - 2];
+    std::size_t off = 0;
+    for (const auto& [m_, closed_r] : rods) {
+      const std::size_t m = std::size_t(m_);
+      const auto tw = twist_density(X.subspan(off, m), d1.subspan(off, m));
+      for (std::size_t k = 0; k < m; ++k) tw_point[off + k] = 0.5 * (tw[(k + m - 1) % m] + tw[k]);
+      if (!closed_r) {  // the ends have one segment each
+        tw_point[off] = tw[0];
+        tw_point[off + m - 1] = tw[m - 2];
+      }
+      off += m;
     }
     const auto [lo, hi] = std::minmax_element(tw_point.begin(), tw_point.end());
     const double t_lo = *lo, t_hi = *hi, t_span = t_hi - t_lo;
@@ -187,18 +224,21 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
   }
   for (const auto& x : X) z_lo = std::min(z_lo, x.z()), z_hi = std::max(z_hi, x.z());
 
-  // vertex tangents (central differences), blended along each segment for smooth shading
+  // vertex tangents (central differences; one-sided at free ends), blended along each segment
+  // for smooth shading
   std::vector<Vec3> vtan(n);
   for (std::size_t k = 0; k < n; ++k) {
-    Vec3 d = X[(k + 1) % n] - X[(k + n - 1) % n];
-    if (!style.closed && k == 0) d = X[1] - X[0];  // open ends: one-sided
-    if (!style.closed && k == n - 1) d = X[n - 1] - X[n - 2];
+    const Vec3& ahead = next[k] >= 0 ? X[std::size_t(next[k])] : X[k];
+    const Vec3& behind = prev[k] >= 0 ? X[std::size_t(prev[k])] : X[k];
+    const Vec3 d = ahead - behind;
     vtan[k] = d.norm() > 0 ? Vec3(d.normalized()) : Vec3(f);
   }
+  std::vector<int> rod_hit(depth.size(), 0);  // the nearest hit's rod, for the outlines
 
-  for (std::size_t k = 0; k < segs; ++k) {
+  for (const std::size_t k : seg) {
+    const std::size_t k1 = std::size_t(next[k]);
     const Vec3& a = X[k];
-    const Vec3& b = X[(k + 1) % n];
+    const Vec3& b = X[k1];
     const Vec3 ab = b - a;
     const double len = ab.norm();
     const Vec3 tan = len > 0 ? Vec3(ab / len) : Vec3(f);
@@ -222,11 +262,11 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
         const Vec3 axis = a + hit.h * ab;
         const Vec3 nrm = (p - axis).normalized();
         // D¹ along the segment, ⟂ to its tangent
-        Vec3 d = (1 - hit.h) * d1[k] + hit.h * d1[(k + 1) % n];
+        Vec3 d = (1 - hit.h) * d1[k] + hit.h * d1[k1];
         d -= d.dot(tan) * tan;
         // compare directions ⟂ to the axis, with the tangent blended between the vertices (on
         // a cap the normal also leans along the axis; a polygonal tube would look faceted)
-        Vec3 tb = (1 - hit.h) * vtan[k] + hit.h * vtan[(k + 1) % n];
+        Vec3 tb = (1 - hit.h) * vtan[k] + hit.h * vtan[k1];
         tb = tb.norm() > 1e-12 ? Vec3(tb.normalized()) : tan;
         const Vec3 np = nrm - nrm.dot(tb) * tb;
         const double dn = d.norm() * np.norm();
@@ -235,12 +275,13 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
         const Vec3 ns = np.norm() > 1e-12 ? Vec3(np.normalized()) : nrm;
         shade[idx] = float(style.ambient + (1 - style.ambient) * std::max(0.0, ns.dot(light)));
         arc[idx] = float(cum[k] + hit.h * len);
+        rod_hit[idx] = rod_of[k];
         if (style.colouring == Colouring::along)
           param[idx] = float((double(k) + hit.h) / double(n));
         else if (style.colouring == Colouring::height)
           param[idx] = z_hi > z_lo ? float((axis.z() - z_lo) / (z_hi - z_lo)) : 0.5f;
         else if (style.colouring == Colouring::twist)
-          param[idx] = float((1 - hit.h) * tw_point[k] + hit.h * tw_point[(k + 1) % n]);
+          param[idx] = float((1 - hit.h) * tw_point[k] + hit.h * tw_point[k1]);
       }
     }
   }
@@ -251,9 +292,12 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
   // toward the viewer in front of its own continuation there is no line across it, which would
   // look like the cap of a free end
   const double arc_gap = style.outline_arc * diameter;
-  const auto far_along = [&](float s1, float s2) {
-    const double ds = std::abs(double(s1) - double(s2));
-    return (style.closed ? std::min(ds, arc_total - ds) : ds) > arc_gap;
+  // two hits far apart along the rod: on different rods, or on one rod more than arc_gap apart
+  const auto far_along = [&](std::size_t i1, std::size_t i2) {
+    if (rod_hit[i1] != rod_hit[i2]) return true;
+    const int r = rod_hit[i1];
+    const double ds = std::abs(double(arc[i1]) - double(arc[i2]));
+    return (rod_closed[r] ? std::min(ds, rod_len[r] - ds) : ds) > arc_gap;
   };
   if (style.outline_darken < 1) {
     const int reach = S;
@@ -268,7 +312,7 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
             if (nx[q] < 0 || ny[q] < 0 || nx[q] >= W || ny[q] >= H) continue;
             const std::size_t nq = std::size_t(ny[q]) * std::size_t(W) + std::size_t(nx[q]);
             if (!std::isfinite(depth[nq]) ||
-                (depth[nq] > depth[idx] + R && far_along(arc[nq], arc[idx])))
+                (depth[nq] > depth[idx] + R && far_along(nq, idx)))
               edge[idx] = 1;
           }
         }

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <vector>
+
+#include "rod/rod_set.hpp"
 
 namespace ibrod::sim {
 
@@ -61,6 +64,68 @@ std::string state_problem(const rod::RodState& s, int n, double ds, bool closed)
                     "the triad of point %d is left-handed (det D = %.3g); D³ must be D¹ × D²", k,
                     det);
       return buf;
+    }
+  return {};
+}
+
+namespace {
+int total_points(std::span<const rod::RodParams> rods) {
+  int n = 0;
+  for (const rod::RodParams& r : rods) n += r.n;
+  return n;
+}
+}  // namespace
+
+std::string rods_problem(std::span<const rod::RodParams> rods, const rod::RodState& s,
+                         double thermal_kT) {
+  if (rods.size() == 1)
+    return rod_problem(s, rods[0].ds, spacing_tolerance(rods[0], thermal_kT), rods[0].closed);
+  const int n = total_points(rods);
+  if (s.size() != n || int(s.D.size()) != n)
+    return std::to_string(s.size()) + " positions and " + std::to_string(s.D.size()) +
+           " triads; the rods have " + std::to_string(n) + " points";
+  rod::RodState one;
+  const std::vector<rod::RodRange> ranges = rod::ranges_of(rods);
+  for (std::size_t r = 0; r < rods.size(); ++r) {
+    rod::extract(s, ranges[r], one);
+    if (std::string bad = rod_problem(one, rods[r].ds, spacing_tolerance(rods[r], thermal_kT),
+                                      rods[r].closed);
+        !bad.empty())
+      return "rod " + std::to_string(r) + ": " + bad;
+  }
+  return {};
+}
+
+std::string rods_state_problem(std::span<const rod::RodParams> rods, const rod::RodState& s) {
+  if (rods.size() == 1) return state_problem(s, rods[0].n, rods[0].ds, rods[0].closed);
+  const int n = total_points(rods);
+  if (s.size() != n || int(s.D.size()) != n)
+    return std::to_string(s.size()) + " positions and " + std::to_string(s.D.size()) +
+           " triads; the rods have " + std::to_string(n) + " points together";
+  rod::RodState one;
+  const std::vector<rod::RodRange> ranges = rod::ranges_of(rods);
+  for (std::size_t r = 0; r < rods.size(); ++r) {
+    rod::extract(s, ranges[r], one);
+    if (std::string bad = state_problem(one, rods[r].n, rods[r].ds, rods[r].closed); !bad.empty())
+      return "rod " + std::to_string(r) + ": " + bad;
+  }
+  // two rods must not start on top of each other (coincident charges, crossed hard cores)
+  for (std::size_t a = 0; a < rods.size(); ++a)
+    for (std::size_t b = a + 1; b < rods.size(); ++b) {
+      const double min_d = 0.5 * std::min(rods[a].ds, rods[b].ds);
+      for (int i = 0; i < ranges[a].n; ++i)
+        for (int j = 0; j < ranges[b].n; ++j) {
+          const double d = (s.X[ranges[a].offset + i] - s.X[ranges[b].offset + j]).norm();
+          if (!(d >= min_d)) {
+            char buf[256];
+            std::snprintf(buf, sizeof buf,
+                          "rods %zu and %zu overlap: point %d of rod %zu and point %d of rod %zu "
+                          "are %.3g Å apart (at least half a rise, %.3g Å, needed; place the rods "
+                          "apart with rod.offset_A)",
+                          a, b, i, a, j, b, d, min_d);
+            return buf;
+          }
+        }
     }
   return {};
 }

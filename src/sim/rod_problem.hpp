@@ -1,5 +1,6 @@
 #pragma once
 // The sanity check of the rod after every step: what the blow-up guard of a run reports.
+#include <span>
 #include <string>
 
 #include "rod/rod.hpp"
@@ -23,5 +24,14 @@ double spacing_tolerance(const rod::RodParams& rod, double thermal_kT);
 /// Python); otherwise what is wrong: a count of positions or triads other than n, what
 /// rod_problem finds, or a left-handed triad (det D < 0: D³ must be D¹ × D²).
 std::string state_problem(const rod::RodState& s, int n, double ds, bool closed = true);
+
+/// The same for the rods of a state of one or several rods laid end to end (rod::RodRange): each
+/// rod checked on its own points with its own Δs, end condition and the spacing tolerance
+/// spacing_tolerance(rod, thermal_kT); with several rods "rod r: " heads what is wrong and point
+/// numbers count within that rod. One rod: exactly rod_problem / state_problem. A state whose
+/// size is not the rods' total is a problem too.
+std::string rods_problem(std::span<const rod::RodParams> rods, const rod::RodState& s,
+                         double thermal_kT);
+std::string rods_state_problem(std::span<const rod::RodParams> rods, const rod::RodState& s);
 
 }  // namespace ibrod::sim

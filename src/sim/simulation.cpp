@@ -64,6 +64,17 @@ SimParams checked(SimParams p) {
     p.stop_kinetic = 0;
     p.stability.enabled = false;
   }
+  if (!p.stepper.more_rods.empty()) {
+    if (p.more_circles.size() != p.stepper.more_rods.size() ||
+        p.more_rotations.size() != p.stepper.more_rods.size())
+      throw std::invalid_argument("Simulation: one initial shape per rod");
+    if (p.scheme == TimeScheme::implicit_step)
+      throw std::invalid_argument(
+          "Simulation: the implicit scheme runs one rod only (docs/model.md \"Several rods\")");
+    // docs/model.md "Several rods": the stability test's kick is a single rod's; a run of several
+    // rods stops at the kinetic-energy rule as it stands
+    p.stability.enabled = false;
+  }
   if (p.scheme == TimeScheme::implicit_step) {
     if (!p.stepper.rod.closed)
       throw std::invalid_argument(
@@ -86,18 +97,44 @@ SimParams checked(SimParams p) {
   }
   return p;
 }
+// One rod's initial shape: the twisted circle (closed) or the straight rod (open), turned about
+// its centroid by R.
+rod::RodState shape_of(const rod::RodParams& rp, const rod::CircleParams& c, const Mat3& R) {
+  rod::RodState s =
+      rp.closed ? rod::twisted_circle(rp, c) : rod::straight_rod(rp, c.perturbation, c.center);
+  if (!R.isIdentity(0)) rod::place(s, R, Vec3::Zero());
+  return s;
+}
+
+// The initial state: each rod's shape, laid end to end.
+rod::RodState initial_state(const SimParams& p) {
+  rod::RodState s = shape_of(p.stepper.rod, p.circle, p.rotation);
+  for (std::size_t r = 0; r < p.stepper.more_rods.size(); ++r)
+    rod::append(s, shape_of(p.stepper.more_rods[r], p.more_circles[r], p.more_rotations[r]));
+  return s;
+}
 }  // namespace
 
 Simulation::Simulation(const SimParams& p)
     : p_(checked(p)),
-      rod_(p_.stepper.rod.closed
-               ? rod::twisted_circle(p_.stepper.rod, p_.circle)
-               : rod::straight_rod(p_.stepper.rod, p_.circle.perturbation, p_.circle.center)),
+      rods_(integrate::all_rods(p_.stepper)),
+      ranges_(rod::ranges_of(rods_)),
+      rod_(initial_state(p_)),
       stepper_(p_.stepper) {
   // MODEL §6: the electrostatic energy is also reported relative to the circle at the same salt.
   // The unperturbed circle (perturbation only rotates triads, so X is the same); for an open rod
   // the straight rod.
-  if (p_.stepper.electro.enabled) electro_circle_ = stepper_.electrostatics().energy(rod_.X);
+  // Several rods: the sum of each rod's own shape alone (rods placed anywhere, even on top of
+  // each other before rod.initial_shape moves them, give the same reference).
+  if (p_.stepper.electro.enabled && rods_.size() == 1)
+    electro_circle_ = stepper_.electrostatics().energy(rod_.X);
+  if (p_.stepper.electro.enabled && rods_.size() > 1) {
+    rod::RodState one;
+    for (const rod::RodRange& g : ranges_) {
+      rod::extract(rod_, g, one);
+      electro_circle_ += interactions::Electrostatics(p_.stepper.electro, g.n).energy(one.X);
+    }
+  }
   if (p_.scheme == TimeScheme::implicit_step)
     implicit_ = std::make_unique<integrate::ImplicitIntegrator>(stepper_, p_.implicit, p_.adaptive);
 }
@@ -108,10 +145,14 @@ void Simulation::set_t_end(double t_end) {
   p_.t_end = t_end;
 }
 
+std::string Simulation::start_problem() const { return rods_state_problem(rods_, rod_); }
+
+std::string Simulation::state_check() const {
+  return rods_problem(rods_, rod_, p_.stepper.fluid.thermal_kT);
+}
+
 void Simulation::set_rod_state(rod::RodState s, const std::string& what) {
-  if (const std::string bad =
-          state_problem(s, p_.stepper.rod.n, p_.stepper.rod.ds, p_.stepper.rod.closed);
-      !bad.empty())
+  if (const std::string bad = rods_state_problem(rods_, s); !bad.empty())
     throw std::invalid_argument(what + ": " + bad);
   rod_ = std::move(s);
   if (implicit_) implicit_->refresh();
@@ -162,12 +203,58 @@ void Simulation::step() {
   time_ += p_.dt;
 }
 
+namespace {
+// The elastic energy of every rod, summed (one rod: elastic_energy itself).
+rod::ElasticEnergy elastic_energy_of(const std::vector<rod::RodParams>& rods,
+                                     const std::vector<rod::RodRange>& ranges,
+                                     const rod::RodState& s) {
+  if (rods.size() == 1) return rod::elastic_energy(rods[0], s);
+  rod::ElasticEnergy e;
+  rod::RodState one;
+  for (std::size_t r = 0; r < rods.size(); ++r) {
+    rod::extract(s, ranges[r], one);
+    const rod::ElasticEnergy er = rod::elastic_energy(rods[r], one);
+    e.bend += er.bend;
+    e.twist += er.twist;
+    e.stretch += er.stretch;
+  }
+  return e;
+}
+
+struct Topology {
+  double writhe, twist, link, closest, spacing;  // spacing: the mean, Å
+  int links;
+};
+
+// One rod's writhe, twist, link (NaN where not defined), closest approach and summed spacing.
+Topology topology_of(const rod::RodState& s, bool closed, int min_separation) {
+  const int n = s.size();
+  std::vector<Vec3> d1(n);
+  for (int k = 0; k < n; ++k) d1[k] = s.D[k].col(0);
+  Topology t{};
+  if (closed) {
+    t.writhe = diagnostics::writhe(s.X);
+    t.twist = diagnostics::twist(s.X, d1);
+    t.link = t.writhe + t.twist;
+  } else {
+    // docs/model.md "Open rods": no link or writhe (not topological with free ends); NaN here is
+    // "not defined", written as an empty CSV field and null in JSON (io/observables)
+    t.writhe = t.link = std::numeric_limits<double>::quiet_NaN();
+    t.twist = diagnostics::twist_open(s.X, d1);
+  }
+  t.closest = diagnostics::closest_approach(s.X, min_separation, closed);
+  t.links = rod::half_points(n, closed);
+  t.spacing = diagnostics::mean_spacing(s.X, closed);
+  return t;
+}
+}  // namespace
+
 Observables Simulation::observe() {
   const double kT = p_.kT;
   Observables o;
   o.step = step_;
   o.time_us = time() / 1e-6;
-  const auto el = rod::elastic_energy(p_.stepper.rod, rod_);
+  const auto el = elastic_energy_of(rods_, ranges_, rod_);
   o.E_bend_kT = el.bend / kT;
   o.E_twist_kT = el.twist / kT;
   o.E_stretch_kT = el.stretch / kT;
@@ -181,28 +268,50 @@ Observables Simulation::observe() {
   o.E_total_kT =
       o.E_bend_kT + o.E_twist_kT + o.E_stretch_kT + o.E_electro_kT + o.E_steric_kT + o.E_kinetic_kT;
 
-  const int n = rod_.size();
-  std::vector<Vec3> d1(n);
-  for (int k = 0; k < n; ++k) d1[k] = rod_.D[k].col(0);
-  const bool closed = p_.stepper.rod.closed;
-  if (closed) {
-    o.writhe = diagnostics::writhe(rod_.X);
-    o.twist = diagnostics::twist(rod_.X, d1);
-    o.link = o.writhe + o.twist;
-  } else {
-    // docs/model.md "Open rods": no link or writhe (not topological with free ends); NaN here is
-    // "not defined", written as an empty CSV field and null in JSON (io/observables)
-    o.writhe = o.link = std::numeric_limits<double>::quiet_NaN();
-    o.twist = diagnostics::twist_open(rod_.X, d1);
+  if (rods_.size() == 1) {
+    const Topology t = topology_of(rod_, rods_[0].closed, p_.closest_min_separation);
+    o.writhe = t.writhe;
+    o.twist = t.twist;
+    o.link = t.link;
+    o.closest_approach_A = t.closest;
+    o.bp_spacing_A = t.spacing;
+    return o;
   }
-  o.closest_approach_A = diagnostics::closest_approach(rod_.X, p_.closest_min_separation, closed);
-  o.bp_spacing_A = diagnostics::mean_spacing(rod_.X, closed);
+  // several rods: each rod's own, summed; the closest approach also over pairs of rods
+  double spacing = 0, closest = HUGE_VAL;
+  int links = 0;
+  rod::RodState one;
+  for (std::size_t r = 0; r < rods_.size(); ++r) {
+    rod::extract(rod_, ranges_[r], one);
+    const Topology t = topology_of(one, rods_[r].closed, p_.closest_min_separation);
+    o.rods.push_back({t.writhe, t.twist, t.link});
+    o.writhe += t.writhe;
+    o.twist += t.twist;
+    o.link += t.link;
+    if (std::isfinite(t.closest)) closest = std::min(closest, t.closest);
+    spacing += t.spacing * t.links;
+    links += t.links;
+  }
+  for (std::size_t a = 0; a < rods_.size(); ++a)
+    for (std::size_t b = a + 1; b < rods_.size(); ++b)
+      for (int i = 0; i < ranges_[a].n; ++i)
+        for (int j = 0; j < ranges_[b].n; ++j)
+          closest = std::min(
+              closest, (rod_.X[ranges_[a].offset + i] - rod_.X[ranges_[b].offset + j]).norm());
+  o.closest_approach_A = closest;
+  o.bp_spacing_A = links > 0 ? spacing / links : 0.0;
+  for (std::size_t a = 0; a < rods_.size(); ++a)
+    for (std::size_t b = a + 1; b < rods_.size(); ++b)
+      if (rods_[a].closed && rods_[b].closed)
+        o.pair_links.push_back(diagnostics::linking_number(
+            std::span<const Vec3>(rod_.X).subspan(ranges_[a].offset, ranges_[a].n),
+            std::span<const Vec3>(rod_.X).subspan(ranges_[b].offset, ranges_[b].n)));
   return o;
 }
 
 double Simulation::total_energy_kT() {
   const double kT = p_.kT;
-  const auto el = rod::elastic_energy(p_.stepper.rod, rod_);
+  const auto el = elastic_energy_of(rods_, ranges_, rod_);
   const double electro =
       p_.stepper.electro.enabled ? stepper_.electrostatics().energy(rod_.X) / kT : 0.0;
   const double steric = p_.stepper.steric.enabled ? stepper_.steric().energy(rod_.X) / kT : 0.0;

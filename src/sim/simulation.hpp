@@ -9,10 +9,12 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "integrate/implicit.hpp"
 #include "integrate/stepper.hpp"
 #include "rod/rod.hpp"
+#include "rod/rod_set.hpp"
 #include "sim/stability.hpp"
 
 namespace ibrod::sim {
@@ -40,7 +42,14 @@ std::string to_string(TimeScheme s);  ///< "explicit", "implicit"
 /// Everything a trajectory needs, in internal units (g, Å, s).
 struct SimParams {
   integrate::StepperParams stepper;  ///< its fluid.dt is set from dt by Simulation
+  /// The first (or only) rod's initial shape: the twisted circle (closed) or the straight rod
+  /// (open) of `circle` (its centre, link and twist perturbation), turned about its centroid by
+  /// `rotation` (rod.rotation_deg).
   rod::CircleParams circle;
+  Mat3 rotation = Mat3::Identity();
+  /// Several rods: the same for stepper.more_rods, one each.
+  std::vector<rod::CircleParams> more_circles;
+  std::vector<Mat3> more_rotations;
   TimeScheme scheme = TimeScheme::explicit_step;
   /// implicit only: the scheme's knobs, and the controller's (its dt_max is set from dt; a
   /// dt_min ≤ 0 becomes 1e-3 dt, a max_displacement ≤ 0 becomes 0.2 min(1/κ, D))
@@ -65,6 +74,18 @@ struct Observables {
   double E_steric_kT = 0, E_kinetic_kT = 0, E_total_kT = 0;
   double writhe = 0, twist = 0, link = 0;
   double closest_approach_A = 0, bp_spacing_A = 0;
+  /// Several rods: each rod's writhe, twist and link (NaN where not defined: open rods); the
+  /// columns above then hold their sums (link and writhe NaN if any rod is open), the closest
+  /// approach over each rod's own pairs and every pair of points of different rods, the
+  /// spacing averaged over all links. Empty for one rod.
+  struct PerRod {
+    double writhe = 0, twist = 0, link = 0;
+  };
+  std::vector<PerRod> rods;
+  /// Several rods: the Gauss linking number of each pair a < b of closed rods, in the order
+  /// (0,1), (0,2), …, (1,2), …; a topological invariant like each rod's link (a passage of one
+  /// rod through another changes it). Empty for one rod.
+  std::vector<double> pair_links;
 };
 
 /// Why a run stopped (summary.json's stop_reason, the checkpoint's): none while it runs.
@@ -79,11 +100,22 @@ std::int64_t steps_to_reach(double t_end, double dt);
 
 class Simulation {
  public:
-  /// Builds the initial state (the twisted circle of p.circle). Throws std::invalid_argument for
-  /// a non-positive Δt or output interval.
+  /// Builds the initial state (the twisted circle of p.circle, or each rod's shape placed in
+  /// turn). Throws std::invalid_argument for a non-positive Δt or output interval.
   explicit Simulation(const SimParams& p);
 
   const SimParams& params() const { return p_; }
+  /// Every rod's parameters, in the state's order (one for a run of one rod).
+  const std::vector<rod::RodParams>& rods() const { return rods_; }
+  /// Where each rod lies in rod() (rod::RodRange).
+  const std::vector<rod::RodRange>& rod_ranges() const { return ranges_; }
+  /// What is wrong with the state, "" if nothing (sim::rods_problem: each rod's spacing, triads,
+  /// finiteness; the spacing tolerance widened for thermal noise).
+  std::string state_check() const;
+  /// What is wrong with the state as a start, "" if nothing: sim::rods_state_problem (each rod's
+  /// count, spacing, triads, handedness; with several rods also two rods closer than half a rise,
+  /// O(n²)). The driver asks before the first step.
+  std::string start_problem() const;
   const rod::RodState& rod() const { return rod_; }
   rod::RodState& rod() { return rod_; }
   integrate::Stepper& stepper() { return stepper_; }
@@ -180,6 +212,8 @@ class Simulation {
   /// without one): the implicit scheme's step is capped by it.
   double time_to_next_output() const;
   SimParams p_;
+  std::vector<rod::RodParams> rods_;
+  std::vector<rod::RodRange> ranges_;
   rod::RodState rod_;
   integrate::Stepper stepper_;
   std::unique_ptr<integrate::ImplicitIntegrator> implicit_;  // time.scheme = "implicit"

@@ -444,3 +444,41 @@ TEST(Render, BadInputThrows) {
 
 }  // namespace
 }  // namespace ibrod::render
+
+namespace ibrod::render {
+namespace {
+TEST(Render, SeveralRodsAreSeparateTubes) {
+  // two open rods along x, 200 Å long, at y = ±60 Å (style.rods): from the top, the strip
+  // between them is background; as one rod of all points a segment would join the end of the
+  // first to the start of the second, across that strip
+  std::vector<Vec3> X, d1;
+  for (int r = 0; r < 2; ++r)
+    for (int k = 0; k < 60; ++k) {
+      X.emplace_back(-100.0 + 200.0 * k / 59, r == 0 ? -60.0 : 60.0, 0.0);
+      d1.emplace_back(0, 0, 1);
+    }
+  Style two;
+  two.rods = {{60, false}, {60, false}};
+  Style one;
+  one.closed = false;
+  const int w = 200, h = 200;
+  const Image a = render_rod(X, d1, 20.0, standard_view("top"), w, h, two);
+  const Image b = render_rod(X, d1, 20.0, standard_view("top"), w, h, one);
+  // the image's middle row: between the rods
+  int joined = 0, apart = 0;
+  for (int x = 0; x < w; ++x) {
+    joined += !is_background(b.at(x, h / 2));
+    apart += !is_background(a.at(x, h / 2));
+  }
+  EXPECT_EQ(apart, 0);
+  EXPECT_GT(joined, 0);
+  // both rods are drawn
+  int rods = 0;
+  for (int y = 0; y < h; ++y) rods += !is_background(a.at(w / 2, y));
+  EXPECT_GT(rods, 10);
+  Style bad = two;
+  bad.rods = {{60, false}, {50, false}};
+  EXPECT_THROW(render_rod(X, d1, 20.0, standard_view("top"), w, h, bad), std::invalid_argument);
+}
+}  // namespace
+}  // namespace ibrod::render
