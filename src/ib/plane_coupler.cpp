@@ -350,25 +350,34 @@ void PlaneCoupler::add_plane(int i, std::array<double*, 3> plane) const {
   spread_plane_entries(v, F_.data(), T_.empty() ? nullptr : T_.data(), plane);
 }
 
-void PlaneCoupler::sample_plane(int i, std::array<const double*, 3> plane) {
-  const PlaneEntries v{grid_.n,
-                       S_,
-                       P_,
-                       entries_.data(),
-                       plane_start_[std::size_t(i)],
-                       plane_start_[std::size_t(i) + 1],
-                       first_.data(),
-                       phi_.data(),
+void PlaneCoupler::sample_plane(int i, std::array<const double*, 3> plane, std::size_t points) {
+  const int begin = plane_start_[std::size_t(i)];
+  int end = plane_start_[std::size_t(i) + 1];
+  if (points < npoints_) {
+    // the plane's entries are in ascending point order: stop at the first point ≥ `points`
+    int lo = begin, hi = end;
+    while (lo < hi) {
+      const int mid = lo + (hi - lo) / 2;
+      if (std::size_t(entries_[2 * std::size_t(mid)]) < points)
+        lo = mid + 1;
+      else
+        hi = mid;
+    }
+    end = lo;
+  }
+  const PlaneEntries v{grid_.n,    S_, P_, entries_.data(), begin, end, first_.data(), phi_.data(),
                        dphi_.data()};
   sample_plane_entries(v, plane, share_.data());
 }
 
-void PlaneCoupler::finish_interpolation(std::span<Vec3> U, std::span<Vec3> W) const {
-  check_size("U", U.size(), npoints_);
-  if (!W.empty()) check_size("W", W.size(), npoints_);
+void PlaneCoupler::finish_interpolation(std::span<Vec3> U, std::span<Vec3> W,
+                                        std::size_t points) const {
+  // U of every point, or of the first `points` (sample_plane's)
+  check_size("U", U.size(), std::min(points, npoints_));
+  if (!W.empty()) check_size("W", W.size(), U.size());
   const double h3 = grid_.h() * grid_.h() * grid_.h();
   const std::size_t S = std::size_t(S_);
-  for (std::size_t k = 0; k < npoints_; ++k) {
+  for (std::size_t k = 0; k < U.size(); ++k) {
     double s[6] = {0, 0, 0, 0, 0, 0};
     for (std::size_t a = 0; a < S; ++a) {  // x-stencil order: fixed, whatever the threads
       const double* sh = share_.data() + 6 * std::size_t(entry_of_[k * S + a]);

@@ -41,10 +41,16 @@ class PlaneCoupler {
   /// Takes x-plane i's share of the interpolation sums from the velocity plane (same layout,
   /// Å s⁻¹). Call once for every plane (concurrently for different planes), then
   /// finish_interpolation().
-  void sample_plane(int i, std::array<const double*, 3> plane);
+  /// `points` < the prepared count: only the first `points` points are sampled (the others are
+  /// spread only: the stochastic drift's force pairs), and finish_interpolation takes U, W of
+  /// that many.
+  void sample_plane(int i, std::array<const double*, 3> plane,
+                    std::size_t points = std::size_t(-1));
 
   /// U (Å s⁻¹) and, unless W is empty, W (s⁻¹) at the prepared points, as Coupler::interpolate.
-  void finish_interpolation(std::span<Vec3> U, std::span<Vec3> W) const;
+  /// With `points` (< the prepared count; as given to sample_plane): U, W of the first `points`.
+  void finish_interpolation(std::span<Vec3> U, std::span<Vec3> W,
+                            std::size_t points = std::size_t(-1)) const;
 
  private:
   GridSpec grid_;

@@ -85,9 +85,11 @@ struct PlaneCouplerForcing final : fluid::PlaneForcing {
 };
 struct PlaneCouplerSampler final : fluid::PlaneSampler {
   ib::PlaneCoupler& coupler;
-  explicit PlaneCouplerSampler(ib::PlaneCoupler& c) : coupler(c) {}
+  std::size_t points;  ///< sample the first `points` points only (all by default)
+  explicit PlaneCouplerSampler(ib::PlaneCoupler& c, std::size_t first = std::size_t(-1))
+      : coupler(c), points(first) {}
   void sample_plane(int i, std::array<const double*, 3> plane) const override {
-    coupler.sample_plane(i, plane);
+    coupler.sample_plane(i, plane, points);
   }
 };
 

@@ -144,5 +144,36 @@ TEST(PlaneCoupler, RejectsMorePointsThanItsBuffersAndMismatchedForces) {
   EXPECT_THROW(pc.finish_interpolation(U1, {}), std::invalid_argument);
 }
 
+TEST(PlaneCoupler, SamplingTheFirstPointsOnlyGivesTheirVelocities) {
+  // the stochastic drift's force pairs are spread, not sampled (sample_plane's `points`): the
+  // first points' U, W are those of sampling every point, bit for bit
+  const GridSpec g{16, 16 * kH};
+  const Coupler cp(g, 1);
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> pos(0.0, g.L), val(-1.0, 1.0);
+  std::vector<Vec3> X(30);
+  for (Vec3& x : X) x = Vec3(pos(rng), pos(rng), pos(rng));
+  std::vector<double> u(3 * g.size());
+  for (double& v : u) v = val(rng);
+  const std::array<const double*, 3> uc{u.data(), u.data() + g.size(), u.data() + 2 * g.size()};
+  auto sample = [&](std::size_t points, std::vector<Vec3>& U, std::vector<Vec3>& W) {
+    PlaneCoupler pc(cp, 30);
+    pc.prepare(X, {}, {});
+    const std::size_t np = std::size_t(g.n) * g.n;
+    for (int i = 0; i < g.n; ++i)
+      pc.sample_plane(i, {uc[0] + i * np, uc[1] + i * np, uc[2] + i * np}, points);
+    pc.finish_interpolation(U, W, points);
+  };
+  std::vector<Vec3> Ua(30), Wa(30), Ub(12), Wb(12);
+  sample(std::size_t(-1), Ua, Wa);
+  sample(12, Ub, Wb);
+  for (int k = 0; k < 12; ++k) {
+    EXPECT_EQ(Ua[k], Ub[k]);
+    EXPECT_EQ(Wa[k], Wb[k]);
+  }
+  std::vector<Vec3> Uc(30), Wc(30);
+  EXPECT_THROW(sample(12, Uc, Wc), std::invalid_argument);  // U of 30 for 12 sampled
+}
+
 }  // namespace
 }  // namespace ibrod::ib
