@@ -206,7 +206,9 @@ class PySimulation {
                                          : std::nan("");
           col.mutable_data()[r] = v;
         }
-        d[(std::string(which == 0 ? "writhe_" : which == 1 ? "twist_" : "link_") +
+        d[(std::string(which == 0   ? "writhe_"
+                       : which == 1 ? "twist_"
+                                    : "link_") +
            std::to_string(q))
               .c_str()] = col;
       }

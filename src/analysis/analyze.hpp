@@ -93,8 +93,8 @@ struct Analysis {
   std::vector<std::pair<std::string, double>> final_energies_kT;  ///< column name, last row
   bool stays_circular = false;  ///< |Wr| < AnalyzeOptions::circular_writhe throughout
   bool open_rod = false;        ///< no writhe in the time series (rod.closed = false): null for the
-                          ///< ring's measures (stays_circular, shape, the power law)
-  bool several_rods = false;  ///< [[rods]]: the shape classes (of one closed curve) are null
+                                ///< ring's measures (stays_circular, shape, the power law)
+  bool several_rods = false;    ///< [[rods]]: the shape classes (of one closed curve) are null
   std::optional<double> kinetic_power_law_exponent;  ///< only for runs that stay circular
   std::optional<FitWindow> kinetic_power_law_fit;
 };

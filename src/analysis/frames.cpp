@@ -316,8 +316,7 @@ std::vector<fs::path> render_run(const fs::path& dir, const RenderOptions& opt, 
           const std::span<const Vec3> x = std::span<const Vec3>(f.X).subspan(off, std::size_t(m));
           const std::span<const Vec3> d = std::span<const Vec3>(f.d1).subspan(off, std::size_t(m));
           char one[40];
-          std::snprintf(one, sizeof one, "%s%s = %.3f", w.empty() ? "" : "  ",
-                        closed ? "Wr" : "Tw",
+          std::snprintf(one, sizeof one, "%s%s = %.3f", w.empty() ? "" : "  ", closed ? "Wr" : "Tw",
                         closed ? diagnostics::writhe(x) : diagnostics::twist_open(x, d));
           w += one;
           off += std::size_t(m);

@@ -147,10 +147,10 @@ void validate_one(const Config& c) {
         "a link small enough that the twisted circle exists (|sin β| = " + fmt(std::abs(sin_beta)) +
             " >= 1)");
   // rod.rotation_deg and rod.offset_A place the built-in shapes only
-  const bool placed = std::any_of(c.rod_rotation_deg.begin(), c.rod_rotation_deg.end(),
-                                  [](double v) { return v != 0; }) ||
-                      std::any_of(c.rod_offset_A.begin(), c.rod_offset_A.end(),
-                                  [](double v) { return v != 0; });
+  const bool placed =
+      std::any_of(c.rod_rotation_deg.begin(), c.rod_rotation_deg.end(),
+                  [](double v) { return v != 0; }) ||
+      std::any_of(c.rod_offset_A.begin(), c.rod_offset_A.end(), [](double v) { return v != 0; });
   if (placed && !c.rod_initial_shape.empty())
     bad("rod.initial_shape", "\"" + c.rod_initial_shape + "\"",
         "\"\" when rod.rotation_deg or rod.offset_A is set (they place the circle or the straight "

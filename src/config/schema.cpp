@@ -539,8 +539,8 @@ std::string toml_text(const toml::node& n);
 // One key of a [[rods]] table: checked at once on a scratch copy (so that an error names the
 // table and the key), kept as text, and set on top of [rod] when rod_config resolves the table.
 void set_rod_key(Config& c, std::size_t r, const std::string& key, const toml::node& value) {
-  const std::string where = "[[rods]] table " + std::to_string(r) + " (rods." + std::to_string(r) +
-                            "." + key + "): ";
+  const std::string where =
+      "[[rods]] table " + std::to_string(r) + " (rods." + std::to_string(r) + "." + key + "): ";
   Config scratch;
   try {
     set_key(scratch, "rod." + key, value);
@@ -635,7 +635,8 @@ void apply_override(Config& c, const std::string& assignment) {
     const std::string rest = key.substr(5);
     const auto dot = rest.find('.');
     std::size_t r = 0;
-    const auto [end, ec] = std::from_chars(rest.data(), rest.data() + std::min(dot, rest.size()), r);
+    const auto [end, ec] =
+        std::from_chars(rest.data(), rest.data() + std::min(dot, rest.size()), r);
     if (dot == std::string::npos || ec != std::errc() || end != rest.data() + dot ||
         r > c.rods.size())
       throw ConfigError("config: --set " + echo(key) +

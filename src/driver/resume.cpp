@@ -43,8 +43,8 @@ void Run::State::open_checkpoint() {
   if (ck.grid_n != c.grid_n || ck.rod.size() != config::point_count(c))
     throw ConfigError(
         "resume: " + cp.string() + " holds a " + std::to_string(ck.grid_n) + "³ grid and " +
-        std::to_string(ck.rod.size()) + " rod points; the configuration asks for grid.n = " +
-        std::to_string(c.grid_n) + " and " +
+        std::to_string(ck.rod.size()) +
+        " rod points; the configuration asks for grid.n = " + std::to_string(c.grid_n) + " and " +
         (c.rods.empty() ? "rod.base_pairs = " + std::to_string(c.rod_base_pairs)
                         : std::to_string(config::point_count(c)) + " points in " +
                               std::to_string(config::rod_count(c)) + " rods ([[rods]])") +

@@ -133,10 +133,10 @@ void Run::State::open_files() {
   // free space kept in hand: a checkpoint (written beside the previous one), a few frames
   // (H5MD + .vtp, ~300 B per point, + the .vti) and 16 MiB of slack
   const std::uintmax_t n = std::uintmax_t(c.grid_n);
-  reserve_bytes =
-      24 * n * n * n +
-      4 * (300u * std::uintmax_t(config::point_count(c)) + (c.output_fluid_vti ? 48u * n * n * n : 0u)) +
-      (std::uintmax_t(16) << 20);
+  reserve_bytes = 24 * n * n * n +
+                  4 * (300u * std::uintmax_t(config::point_count(c)) +
+                       (c.output_fluid_vti ? 48u * n * n * n : 0u)) +
+                  (std::uintmax_t(16) << 20);
 }
 
 void Run::State::announce() {
@@ -150,14 +150,14 @@ void Run::State::announce() {
                   static_cast<long long>(sim->end_step()), meta.threads,
                   static_cast<long long>(p.output.checkpoints));
   else
-    std::snprintf(buf, sizeof buf,
-                  "ibrod: %lld steps of %.4g ns on %d³, %d rod points%s, ΔLk = %d, %d threads -> %s",
-                  static_cast<long long>(sim->end_step()), sim->dt() / 1e-9, p.stepper.grid.n,
-                  sim->rod().size(),
-                  sim->rods().size() > 1
-                      ? (" in " + std::to_string(sim->rods().size()) + " rods").c_str()
-                      : "",
-                  p.circle.excess_link, meta.threads, dir.root().c_str());
+    std::snprintf(
+        buf, sizeof buf,
+        "ibrod: %lld steps of %.4g ns on %d³, %d rod points%s, ΔLk = %d, %d threads -> %s",
+        static_cast<long long>(sim->end_step()), sim->dt() / 1e-9, p.stepper.grid.n,
+        sim->rod().size(),
+        sim->rods().size() > 1 ? (" in " + std::to_string(sim->rods().size()) + " rods").c_str()
+                               : "",
+        p.circle.excess_link, meta.threads, dir.root().c_str());
   say(buf);
   if (distributed)
     say("ibrod: the fluid grid is split over " + std::to_string(opt.ranks) + " MPI ranks (" +

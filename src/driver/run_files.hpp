@@ -72,9 +72,9 @@ class RunFiles {
           ts, io::timeseries_up_to(try_read_text_file(ts).value_or(""), io::timeseries_header(),
                                    resume_step, ts.string()));
       if (several)
-        io::write_file_atomic(dir.rods(), io::timeseries_up_to(
-                                              try_read_text_file(dir.rods()).value_or(""),
-                                              rods_header, resume_step, dir.rods().string()));
+        io::write_file_atomic(dir.rods(),
+                              io::timeseries_up_to(try_read_text_file(dir.rods()).value_or(""),
+                                                   rods_header, resume_step, dir.rods().string()));
       if (frame_step < 0) frame_step = resume_step;
       if (frames_on_)
         reopen_trajectory(dir.trajectory(), n, c.grid_box_A, frame_step, config_text, progress);
@@ -123,8 +123,8 @@ class RunFiles {
     if (std::fprintf(ts_, "%s\n", io::timeseries_row(o).c_str()) < 0 || std::fflush(ts_) != 0)
       throw RunError("output: cannot write " + dir_.timeseries().string() + ": " +
                      io::io_error_text(errno));
-    if (rods_ && (std::fprintf(rods_, "%s\n", io::rods_row(o).c_str()) < 0 ||
-                  std::fflush(rods_) != 0))
+    if (rods_ &&
+        (std::fprintf(rods_, "%s\n", io::rods_row(o).c_str()) < 0 || std::fflush(rods_) != 0))
       throw RunError("output: cannot write " + dir_.rods().string() + ": " +
                      io::io_error_text(errno));
     if (h5_) h5_->write_observables(o);
@@ -136,9 +136,8 @@ class RunFiles {
     const double t_us = sim.time() / 1e-6;
     h5_->write_frame(sim.step_count(), t_us, sim.rod());
     rod_pvd_.add(sim.step_count(), t_us,
-                 ranges_.size() > 1
-                     ? io::rod_vtp(sim.rod(), rod_ds_, ranges_)
-                     : io::rod_vtp(sim.rod(), ds_, sim.params().stepper.rod.closed));
+                 ranges_.size() > 1 ? io::rod_vtp(sim.rod(), rod_ds_, ranges_)
+                                    : io::rod_vtp(sim.rod(), ds_, sim.params().stepper.rod.closed));
     if (vti_) fluid_pvd_.add(sim.step_count(), t_us, io::fluid_vti(sim.params().stepper.grid, u));
   }
 

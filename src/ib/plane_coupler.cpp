@@ -365,8 +365,8 @@ void PlaneCoupler::sample_plane(int i, std::array<const double*, 3> plane, std::
     }
     end = lo;
   }
-  const PlaneEntries v{grid_.n,    S_, P_, entries_.data(), begin, end, first_.data(), phi_.data(),
-                       dphi_.data()};
+  const PlaneEntries v{grid_.n,       S_,          P_,          entries_.data(), begin, end,
+                       first_.data(), phi_.data(), dphi_.data()};
   sample_plane_entries(v, plane, share_.data());
 }
 

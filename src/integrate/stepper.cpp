@@ -296,7 +296,8 @@ void Stepper::drift_step(rod::RodState& s, PhaseClock& clock) {
   clock.mark(4);
   fluid_->pass_inverse_planes(&sampler);
   clock.mark(5);
-  plane_coupler_.finish_interpolation(std::span<Vec3>(Ua_.data(), n), std::span<Vec3>(Wa_.data(), n), n);
+  plane_coupler_.finish_interpolation(std::span<Vec3>(Ua_.data(), n),
+                                      std::span<Vec3>(Wa_.data(), n), n);
   for (std::size_t k = 0; k < n; ++k) Xa_[k] = s.X[k] + (0.5 * dt) * Ua_[k];
   // the midpoint interpolation through the plane coupler, as the step's own: the kernel weights
   // once, each x-plane of uⁿ⁺¹ sampled while in cache, the planes' shares added in x-stencil

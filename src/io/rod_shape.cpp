@@ -50,8 +50,8 @@ rod::RodState from_csv(const std::string& path, const std::string& key, int rod_
       if (rod[k] == want) rows.push_back(k);
     if (rows.empty())
       throw ConfigError(key + " = '" + path + "': the file has no rows of rod " +
-                        std::to_string(want) + " (it holds rods 0 to " +
-                        std::to_string(int(most)) + ")");
+                        std::to_string(want) + " (it holds rods 0 to " + std::to_string(int(most)) +
+                        ")");
   } else {
     for (std::size_t k = 0; k < t.rows(); ++k) rows.push_back(k);
   }

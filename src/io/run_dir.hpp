@@ -49,8 +49,8 @@ class RunDir {
 
   /// Every file and folder a run writes (what --overwrite removes before a new run).
   std::vector<std::filesystem::path> run_files() const {
-    return {config(),       timeseries(), trajectory(),  root_ / "rod.pvd", root_ / "fluid.pvd",
-            checkpoint(),   wisdom(),     final_state(), summary(),         velocity(),
+    return {config(),        timeseries(), trajectory(),  root_ / "rod.pvd", root_ / "fluid.pvd",
+            checkpoint(),    wisdom(),     final_state(), summary(),         velocity(),
             root_ / kVtkDir, rods()};
   }
 

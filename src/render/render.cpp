@@ -311,8 +311,7 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
           for (int q = 0; q < 4; ++q) {
             if (nx[q] < 0 || ny[q] < 0 || nx[q] >= W || ny[q] >= H) continue;
             const std::size_t nq = std::size_t(ny[q]) * std::size_t(W) + std::size_t(nx[q]);
-            if (!std::isfinite(depth[nq]) ||
-                (depth[nq] > depth[idx] + R && far_along(nq, idx)))
+            if (!std::isfinite(depth[nq]) || (depth[nq] > depth[idx] + R && far_along(nq, idx)))
               edge[idx] = 1;
           }
         }

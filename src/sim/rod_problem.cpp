@@ -88,8 +88,8 @@ std::string rods_problem(std::span<const rod::RodParams> rods, const rod::RodSta
   const std::vector<rod::RodRange> ranges = rod::ranges_of(rods);
   for (std::size_t r = 0; r < rods.size(); ++r) {
     rod::extract(s, ranges[r], one);
-    if (std::string bad = rod_problem(one, rods[r].ds, spacing_tolerance(rods[r], thermal_kT),
-                                      rods[r].closed);
+    if (std::string bad =
+            rod_problem(one, rods[r].ds, spacing_tolerance(rods[r], thermal_kT), rods[r].closed);
         !bad.empty())
       return "rod " + std::to_string(r) + ": " + bad;
   }

@@ -59,10 +59,11 @@ TEST(SeveralRods, ConfigTablesResolveOnTopOfRod) {
             std::string::npos);
   // from a file
   config::Config f;
-  config::apply_toml(f,
-                     "[rod]\nbase_pairs = 50\n[[rods]]\nexcess_link = 0\n[[rods]]\nbase_pairs = 30\n"
-                     "closed = false\nexcess_link = 0\n",
-                     "f.toml");
+  config::apply_toml(
+      f,
+      "[rod]\nbase_pairs = 50\n[[rods]]\nexcess_link = 0\n[[rods]]\nbase_pairs = 30\n"
+      "closed = false\nexcess_link = 0\n",
+      "f.toml");
   EXPECT_EQ(config::rod_count(f), 2);
   EXPECT_EQ(config::rod_config(f, 0).rod_base_pairs, 50);
   EXPECT_FALSE(config::rod_config(f, 1).rod_closed);
@@ -86,8 +87,7 @@ TEST(SeveralRods, BadTablesNameTheTableAndKey) {
   EXPECT_NE(value.find("[[rods]] table 0"), std::string::npos) << value;
   const std::string skip = message([&] { config::apply_override(c, "rods.3.base_pairs=30"); });
   EXPECT_NE(skip.find("from 0 to 0"), std::string::npos) << skip;
-  const std::string notable =
-      message([&] { config::apply_toml(c, "rods = 3\n", "f.toml"); });
+  const std::string notable = message([&] { config::apply_toml(c, "rods = 3\n", "f.toml"); });
   EXPECT_NE(notable.find("array of tables"), std::string::npos) << notable;
   config::Config impl = two_rings();
   impl.time_scheme = "implicit";

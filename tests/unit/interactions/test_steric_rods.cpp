@@ -44,8 +44,8 @@ TEST(StericRods, TwoRodsCellListEqualsDirectAndOracle) {
           const auto [b0, b1] = seg(q, l);
           oracle += steric_pair(D, g, X[a0], X[a1], X[b0], X[b1], f);
         }
-  std::printf("  two strands as two rods: E %.6g kT (direct %.6g, oracle %.6g), cells %d\n",
-              E / kT, Ed / kT, oracle / kT, int(st.used_cell_list()));
+  std::printf("  two strands as two rods: E %.6g kT (direct %.6g, oracle %.6g), cells %d\n", E / kT,
+              Ed / kT, oracle / kT, int(st.used_cell_list()));
   ASSERT_GT(oracle, 0.0);
   EXPECT_NEAR(E, oracle, 1e-12 * oracle);
   EXPECT_NEAR(Ed, oracle, 1e-12 * oracle);
