@@ -630,28 +630,6 @@ void apply_override(Config& c, const std::string& assignment) {
                       "' must have the form section.key=value");
   std::string key = assignment.substr(0, eq), value = assignment.substr(eq + 1);
   while (!key.empty() && key.back() == ' ') key.pop_back();
-  // rods.K.key=value: a key of [[rods]] table K
-  if (key.rfind("rods.", 0) == 0) {
-    const std::string rest = key.substr(5);
-    const auto dot = rest.find('.');
-    std::size_t r = 0;
-    const auto [end, ec] =
-        std::from_chars(rest.data(), rest.data() + std::min(dot, rest.size()), r);
-    if (dot == std::string::npos || ec != std::errc() || end != rest.data() + dot ||
-        r > c.rods.size())
-      throw ConfigError("config: --set " + echo(key) +
-                        ": a [[rods]] key is rods.K.key with K a table number from 0 to " +
-                        std::to_string(c.rods.size()) + " (" + std::to_string(c.rods.size()) +
-                        " appends a table)");
-    toml::table t;  // the value parsed as any other, then kept as the table's
-    try {
-      t = toml::parse("v = " + value, "--set " + key);
-    } catch (const toml::parse_error&) {
-      t = toml::parse("v = \"" + value + "\"", "--set " + key);
-    }
-    set_rod_key(c, r, rest.substr(dot + 1), *t.get("v"));
-    return;
-  }
   // One line, one value: a newline would let TOML read (and this function drop) a second key.
   for (const char ch : assignment)
     if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f)
@@ -668,14 +646,27 @@ void apply_override(Config& c, const std::string& assignment) {
         std::all_of(value.begin(), value.end(), [](char ch) {
           return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-';
         });
-    if (word) {
-      t = toml::parse("v = \"" + value + "\"", "--set " + key);
-      set_key(c, key, *t.get("v"));
-      return;
-    }
-    throw ConfigError("config: --set " + echo(key) + "=" + echo(value) +
-                      ": the value is not a TOML number, boolean, string or array (" +
-                      echo(std::string(e.description()), 200) + ")");
+    if (!word)
+      throw ConfigError("config: --set " + echo(key) + "=" + echo(value) +
+                        ": the value is not a TOML number, boolean, string or array (" +
+                        echo(std::string(e.description()), 200) + ")");
+    t = toml::parse("v = \"" + value + "\"", "--set " + key);
+  }
+  // rods.K.key=value: a key of [[rods]] table K
+  if (key.rfind("rods.", 0) == 0) {
+    const std::string rest = key.substr(5);
+    const auto dot = rest.find('.');
+    std::size_t r = 0;
+    const auto [end, ec] =
+        std::from_chars(rest.data(), rest.data() + std::min(dot, rest.size()), r);
+    if (dot == std::string::npos || ec != std::errc() || end != rest.data() + dot ||
+        r > c.rods.size())
+      throw ConfigError("config: --set " + echo(key) +
+                        ": a [[rods]] key is rods.K.key with K a table number from 0 to " +
+                        std::to_string(c.rods.size()) + " (" + std::to_string(c.rods.size()) +
+                        " appends a table)");
+    set_rod_key(c, r, rest.substr(dot + 1), *t.get("v"));
+    return;
   }
   set_key(c, key, *t.get("v"));
 }

@@ -88,32 +88,36 @@ CsvTable read_csv_table(const fs::path& path) {
   return t;
 }
 
-std::string final_state_csv(const rod::RodState& s) {
-  std::string out = "x_A,y_A,z_A,d1x,d1y,d1z,d2x,d2y,d2z,d3x,d3y,d3z\n";
+namespace {
+// One point's row of final_state.csv (no newline): position and triad columns, 17 digits.
+void append_state_row(std::string& out, const Vec3& x, const Mat3& D) {
   char buf[512];
+  std::snprintf(buf, sizeof buf,
+                "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", x[0],
+                x[1], x[2], D(0, 0), D(1, 0), D(2, 0), D(0, 1), D(1, 1), D(2, 1), D(0, 2), D(1, 2),
+                D(2, 2));
+  out += buf;
+}
+constexpr const char* kStateHeader = "x_A,y_A,z_A,d1x,d1y,d1z,d2x,d2y,d2z,d3x,d3y,d3z\n";
+}  // namespace
+
+std::string final_state_csv(const rod::RodState& s) {
+  std::string out = kStateHeader;
   for (int k = 0; k < s.size(); ++k) {
-    const Vec3& x = s.X[k];
-    const Mat3& D = s.D[k];
-    std::snprintf(buf, sizeof buf,
-                  "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", x[0],
-                  x[1], x[2], D(0, 0), D(1, 0), D(2, 0), D(0, 1), D(1, 1), D(2, 1), D(0, 2),
-                  D(1, 2), D(2, 2));
-    out += buf;
+    append_state_row(out, s.X[k], s.D[k]);
+    out += '\n';
   }
   return out;
 }
 
 std::string final_state_csv(const rod::RodState& s, const std::vector<rod::RodRange>& ranges) {
   if (ranges.size() <= 1) return final_state_csv(s);
-  const std::string plain = final_state_csv(s);
-  // the same lines, each after its rod's number
-  std::string out = "rod," + plain.substr(0, plain.find('\n') + 1);
-  std::size_t pos = plain.find('\n') + 1;
+  std::string out = std::string("rod,") + kStateHeader;  // each row after its rod's number
   for (std::size_t r = 0; r < ranges.size(); ++r)
-    for (int k = 0; k < ranges[r].n; ++k) {
-      const std::size_t end = plain.find('\n', pos);
-      out += std::to_string(r) + "," + plain.substr(pos, end + 1 - pos);
-      pos = end + 1;
+    for (int k = ranges[r].offset; k < ranges[r].offset + ranges[r].n; ++k) {
+      out += std::to_string(r) + ",";
+      append_state_row(out, s.X[k], s.D[k]);
+      out += '\n';
     }
   return out;
 }

@@ -52,55 +52,10 @@ double twist_density(const Mat3& Dk, const Mat3& Dk1, double ds) {
 
 }  // namespace
 
-std::string rod_vtp(const rod::RodState& s, double ds_A, bool closed) {
-  const int n = s.size();
-  std::vector<double> omega(n), strain(n);
-  for (int k = 0; k < rod::half_points(n, closed); ++k) {
-    const int k1 = k + 1 == n ? 0 : k + 1;
-    omega[k] = twist_density(s.D[k], s.D[k1], ds_A);  // half point k+½
-    strain[k] = (s.X[k1] - s.X[k]).norm() / ds_A - 1.0;
-  }
-  std::string out;
-  out.reserve(std::size_t(n) * 260 + 1024);
-  out +=
-      "<?xml version=\"1.0\"?>\n"
-      "<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" "
-      "header_type=\"UInt64\">\n"
-      "  <PolyData>\n";
-  out += "    <Piece NumberOfPoints=\"" + std::to_string(n) +
-         "\" NumberOfVerts=\"0\" NumberOfLines=\"1\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n";
-  if (!closed && n >= 2) {  // no half point n−½: the last point takes its one neighbour's
-    omega[n - 1] = omega[n - 2];
-    strain[n - 1] = strain[n - 2];
-  }
-  out += "      <PointData Scalars=\"twist_density_rad_per_A\" Vectors=\"d3\">\n";
-  const char* const triad_names[3] = {"d1", "d2", "d3"};
-  for (int c = 0; c < 3; ++c) {
-    data_array(out, "Float64", triad_names[c], 3, n,
-               [&](std::size_t k, int i) { return s.D[k](i, c); });
-  }
-  data_array(out, "Float64", "twist_density_rad_per_A", 1, n, [&](std::size_t k, int) {
-    if (!closed && k == 0) return omega[0];  // an open rod's first point: no half point −½
-    return 0.5 * (omega[k] + omega[k == 0 ? n - 1 : k - 1]);
-  });
-  data_array(out, "Float64", "stretch_strain", 1, n, [&](std::size_t k, int) { return strain[k]; });
-  out += "      </PointData>\n      <Points>\n";
-  data_array(out, "Float64", "Points", 3, n, [&](std::size_t k, int i) { return s.X[k][i]; });
-  out += "      </Points>\n      <Lines>\n";
-  // closed polyline: the first point again at the end; open: the n points alone
-  const std::size_t m = std::size_t(n) + (closed ? 1 : 0);
-  data_array(
-      out, "Int64", "connectivity", 1, m,
-      [&](std::size_t k, int) { return double(k == std::size_t(n) ? 0 : k); }, "%.0f");
-  data_array(
-      out, "Int64", "offsets", 1, 1, [&](std::size_t, int) { return double(m); }, "%.0f");
-  out += "      </Lines>\n    </Piece>\n  </PolyData>\n</VTKFile>\n";
-  return out;
-}
-
-std::string rod_vtp(const rod::RodState& s, const std::vector<double>& ds_A,
-                    const std::vector<rod::RodRange>& ranges) {
-  if (ranges.size() == 1) return rod_vtp(s, ds_A.at(0), ranges[0].closed);
+namespace {
+// The .vtp of rods laid end to end (one polyline each); `rod_array`: the point array `rod`.
+std::string rods_vtp(const rod::RodState& s, const std::vector<double>& ds_A,
+                     const std::vector<rod::RodRange>& ranges, bool rod_array) {
   const int n = s.size();
   std::vector<double> omega(n), strain(n), rod_of(n);
   std::size_t lines = 0;  // connectivity entries
@@ -150,8 +105,9 @@ std::string rod_vtp(const rod::RodState& s, const std::vector<double>& ds_A,
   data_array(out, "Float64", "twist_density_rad_per_A", 1, n,
              [&](std::size_t k, int) { return omega[k]; });
   data_array(out, "Float64", "stretch_strain", 1, n, [&](std::size_t k, int) { return strain[k]; });
-  data_array(
-      out, "Int32", "rod", 1, n, [&](std::size_t k, int) { return rod_of[k]; }, "%.0f");
+  if (rod_array)
+    data_array(
+        out, "Int32", "rod", 1, n, [&](std::size_t k, int) { return rod_of[k]; }, "%.0f");
   out += "      </PointData>\n      <Points>\n";
   data_array(out, "Float64", "Points", 3, n, [&](std::size_t k, int i) { return s.X[k][i]; });
   out += "      </Points>\n      <Lines>\n";
@@ -163,6 +119,16 @@ std::string rod_vtp(const rod::RodState& s, const std::vector<double>& ds_A,
       "%.0f");
   out += "      </Lines>\n    </Piece>\n  </PolyData>\n</VTKFile>\n";
   return out;
+}
+}  // namespace
+
+std::string rod_vtp(const rod::RodState& s, double ds_A, bool closed) {
+  return rods_vtp(s, {ds_A}, {{0, s.size(), closed}}, false);
+}
+
+std::string rod_vtp(const rod::RodState& s, const std::vector<double>& ds_A,
+                    const std::vector<rod::RodRange>& ranges) {
+  return rods_vtp(s, ds_A, ranges, ranges.size() > 1);
 }
 
 std::string fluid_vti(const GridSpec& g, std::array<const double*, 3> u) {

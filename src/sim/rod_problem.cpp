@@ -19,20 +19,25 @@ double spacing_tolerance(const rod::RodParams& rod, double thermal_kT) {
 }
 
 std::string rod_problem(const rod::RodState& s, double ds, double tolerance, bool closed) {
+  return rod_problem(s.X, s.D, ds, tolerance, closed);
+}
+
+std::string rod_problem(std::span<const Vec3> X, std::span<const Mat3> D, double ds,
+                        double tolerance, bool closed) {
   const double lo = std::max(0.05, 1.0 - tolerance), hi = 1.0 + tolerance;
-  const int n = s.size();
+  const int n = int(X.size());
   char buf[256];
   for (int k = 0; k < n; ++k) {
-    if (!s.X[k].allFinite()) {
+    if (!X[k].allFinite()) {
       std::snprintf(buf, sizeof buf, "the position of point %d is not finite (%g, %g, %g) Å", k,
-                    s.X[k][0], s.X[k][1], s.X[k][2]);
+                    X[k][0], X[k][1], X[k][2]);
       return buf;
     }
-    if (!s.D[k].allFinite()) return "the triad of point " + std::to_string(k) + " is not finite";
+    if (!D[k].allFinite()) return "the triad of point " + std::to_string(k) + " is not finite";
   }
   for (int k = 0; k < rod::half_points(n, closed); ++k) {
     const int k1 = k + 1 == n ? 0 : k + 1;
-    const double r = (s.X[k1] - s.X[k]).norm() / ds;
+    const double r = (X[k1] - X[k]).norm() / ds;
     if (!(r >= lo && r <= hi)) {
       std::snprintf(buf, sizeof buf,
                     "the spacing of points %d and %d is %.4g Δs (allowed: %.4g to %.4g Δs)", k, k1,
@@ -41,7 +46,7 @@ std::string rod_problem(const rod::RodState& s, double ds, double tolerance, boo
     }
   }
   for (int k = 0; k < n; ++k) {
-    const double e = (s.D[k].transpose() * s.D[k] - Mat3::Identity()).cwiseAbs().maxCoeff();
+    const double e = (D[k].transpose() * D[k] - Mat3::Identity()).cwiseAbs().maxCoeff();
     if (!(e <= 1e-3)) {
       std::snprintf(
           buf, sizeof buf,
@@ -77,21 +82,22 @@ int total_points(std::span<const rod::RodParams> rods) {
 }  // namespace
 
 std::string rods_problem(std::span<const rod::RodParams> rods, const rod::RodState& s,
-                         double thermal_kT) {
-  if (rods.size() == 1)
-    return rod_problem(s, rods[0].ds, spacing_tolerance(rods[0], thermal_kT), rods[0].closed);
+                         std::span<const double> tolerances) {
+  if (rods.size() == 1) return rod_problem(s, rods[0].ds, tolerances[0], rods[0].closed);
   const int n = total_points(rods);
   if (s.size() != n || int(s.D.size()) != n)
     return std::to_string(s.size()) + " positions and " + std::to_string(s.D.size()) +
            " triads; the rods have " + std::to_string(n) + " points";
-  rod::RodState one;
-  const std::vector<rod::RodRange> ranges = rod::ranges_of(rods);
+  const std::span<const Vec3> X(s.X);
+  const std::span<const Mat3> D(s.D);
+  std::size_t offset = 0;
   for (std::size_t r = 0; r < rods.size(); ++r) {
-    rod::extract(s, ranges[r], one);
-    if (std::string bad =
-            rod_problem(one, rods[r].ds, spacing_tolerance(rods[r], thermal_kT), rods[r].closed);
+    const std::size_t m = std::size_t(rods[r].n);
+    if (std::string bad = rod_problem(X.subspan(offset, m), D.subspan(offset, m), rods[r].ds,
+                                      tolerances[r], rods[r].closed);
         !bad.empty())
       return "rod " + std::to_string(r) + ": " + bad;
+    offset += m;
   }
   return {};
 }

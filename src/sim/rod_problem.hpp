@@ -13,6 +13,9 @@ namespace ibrod::sim {
 /// spacing between the last point and the first.
 std::string rod_problem(const rod::RodState& s, double ds, double tolerance = 0.5,
                         bool closed = true);
+/// The same on the points X and triads D of one rod (a range of a state of several rods).
+std::string rod_problem(std::span<const Vec3> X, std::span<const Mat3> D, double ds,
+                        double tolerance, bool closed);
 
 /// The spacing tolerance of rod_problem for a run: 0.5, or with thermal noise (docs/thermal.md)
 /// seven standard deviations of the thermal stretch or shear of one segment,
@@ -26,12 +29,13 @@ double spacing_tolerance(const rod::RodParams& rod, double thermal_kT);
 std::string state_problem(const rod::RodState& s, int n, double ds, bool closed = true);
 
 /// The same for the rods of a state of one or several rods laid end to end (rod::RodRange): each
-/// rod checked on its own points with its own Δs, end condition and the spacing tolerance
-/// spacing_tolerance(rod, thermal_kT); with several rods "rod r: " heads what is wrong and point
-/// numbers count within that rod. One rod: exactly rod_problem / state_problem. A state whose
-/// size is not the rods' total is a problem too.
+/// rod checked in place on its own points with its own Δs, end condition and spacing tolerance
+/// (`tolerances`, one per rod: spacing_tolerance(rod, thermal_kT), computed once per run); with
+/// several rods "rod r: " heads what is wrong and point numbers count within that rod. One rod:
+/// exactly rod_problem / state_problem. A state whose size is not the rods' total is a problem
+/// too. O(n), no allocation: the blow-up guard after every step.
 std::string rods_problem(std::span<const rod::RodParams> rods, const rod::RodState& s,
-                         double thermal_kT);
+                         std::span<const double> tolerances);
 std::string rods_state_problem(std::span<const rod::RodParams> rods, const rod::RodState& s);
 
 }  // namespace ibrod::sim

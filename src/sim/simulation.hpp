@@ -214,6 +214,7 @@ class Simulation {
   SimParams p_;
   std::vector<rod::RodParams> rods_;
   std::vector<rod::RodRange> ranges_;
+  std::vector<double> tolerances_;  ///< each rod's spacing tolerance (state_check)
   rod::RodState rod_;
   integrate::Stepper stepper_;
   std::unique_ptr<integrate::ImplicitIntegrator> implicit_;  // time.scheme = "implicit"
