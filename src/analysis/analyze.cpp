@@ -76,10 +76,6 @@ RunInfo read_run_info(const fs::path& dir) {
 
 // ---- analyze
 
-namespace {
-
-/// The rows in strictly increasing time: where time goes back (a run continued from an earlier
-/// checkpoint appends rows it had already written), the later rows win.
 CsvTable increasing_rows(const CsvTable& table) {
   const auto time = table.column("time_us");
   std::vector<std::size_t> keep;
@@ -95,8 +91,6 @@ CsvTable increasing_rows(const CsvTable& table) {
   }
   return ts;
 }
-
-}  // namespace
 
 Analysis analyze_timeseries(const CsvTable& table, const AnalyzeOptions& opt) {
   const CsvTable ts = increasing_rows(table);

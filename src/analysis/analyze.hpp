@@ -99,6 +99,11 @@ struct Analysis {
   std::optional<FitWindow> kinetic_power_law_fit;
 };
 
+/// The rows of `table` in strictly increasing time_us: where time goes back (a run continued
+/// from an earlier checkpoint appends rows it had already written), the later rows win; rows with
+/// a non-finite time are dropped.
+CsvTable increasing_rows(const CsvTable& table);
+
 /// The analysis of timeseries.csv's columns (time_us, writhe, E_kinetic_kT, E_total_kT,
 /// closest_approach_A are needed; ConfigError otherwise, or with fewer than 2 rows). Rows whose
 /// time is not below that of every later row (a continued run that rewrote a stretch) are
