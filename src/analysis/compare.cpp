@@ -189,19 +189,20 @@ std::vector<std::string> compare_failures(const Comparison& c, const CompareLimi
   std::vector<std::string> out;
   if (!limits.any()) return out;
   const auto check = [&](const std::optional<double>& limit, double value, double t,
-                         const std::string& what, const char* option) {
+                         const std::string& what, const char* unit, const char* option) {
     if (!limit) return;
     if (!std::isfinite(value))
       out.push_back(what + " is not defined (" + option + " " + num(*limit) + ")");
     else if (value > *limit)
-      out.push_back(what + " = " + num(value) +
+      out.push_back(what + " = " + num(value) + unit +
                     (std::isfinite(t) ? " at t = " + num(t) + " us" : "") + " > " + option + " " +
                     num(*limit));
   };
-  check(limits.max_dwr, c.max_abs_dwr, c.max_abs_dwr_time_us, "max |dWr|", "--max-dwr");
-  check(limits.max_de_kT, c.max_abs_de_kT, c.max_abs_de_time_us, "max |dE_total| (kT)", "--max-de");
+  check(limits.max_dwr, c.max_abs_dwr, c.max_abs_dwr_time_us, "max |dWr|", "", "--max-dwr");
+  check(limits.max_de_kT, c.max_abs_de_kT, c.max_abs_de_time_us, "max |dE_total|", " kT",
+        "--max-de");
   check(limits.max_final_de_kT, std::abs(c.final_de_kT), c.final_time_us,
-        "|dE_total| (kT) at the last common time", "--max-final-de");
+        "|dE_total| at the last common time", " kT", "--max-final-de");
   if (c.shape_mismatches > 0) {
     std::string s = std::to_string(c.shape_mismatches) +
                     " frame(s) with another shape class or loop count outside the guard: t =";
