@@ -236,7 +236,9 @@ std::string compare_table(const Comparison& c) {
                   col("%+.3e", f.E_total_b_kT - f.E_total_a_kT).c_str(),
                   shape_text(f.class_a, f.loops_a).c_str(),
                   shape_text(f.class_b, f.loops_b).c_str(), frame_flag_name(f.flag));
-    s += buf;
+    std::string line = buf;  // no trailing blanks where the flag is empty
+    line.erase(line.find_last_not_of(" \n") + 1);
+    s += line + "\n";
   }
   return s;
 }
