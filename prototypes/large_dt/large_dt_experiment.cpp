@@ -34,7 +34,9 @@ int main(int argc, char** argv) {
                                         {"form", "velocity"},
                                         {"energy_every_step", "0"},
                                         {"dmax", "2"},
-                                        {"etol", "1e-3"}};
+                                        {"etol", "1e-3"},
+                                        {"order", "1"},
+                                        {"err_tol", "0"}};
   config::Config cfg;
   // the experiment's ring: 32³, h as at the reference (11.33 Å), 150 bp, ΔLk = 3, 0.1 M
   for (const char* s : {"grid.n=32", "grid.box_A=362.5", "rod.base_pairs=150", "rod.excess_link=3",
@@ -67,6 +69,7 @@ int main(int argc, char** argv) {
   ip.stiffness_fd = kv["K"] == "fd";
   ip.steric_implicit = kv["steric_implicit"] == "1";
   ip.velocity_form = kv["form"] != "force";
+  ip.order = std::stoi(kv["order"]);
   std::unique_ptr<integrate::ImplicitStepper> imp;
   if (scheme != "explicit") imp = std::make_unique<integrate::ImplicitStepper>(st, ip);
   if (imp)
@@ -96,6 +99,7 @@ int main(int argc, char** argv) {
   ap.dt_min = 1e-3 * dt;
   ap.max_displacement = std::stod(kv["dmax"]);
   ap.energy_tolerance = std::stod(kv["etol"]) * kT;
+  ap.error_tolerance = std::stod(kv["err_tol"]);
   integrate::AdaptiveDt ctl(ap);
   double dt_min_used = dt;
   for (long s = 0;; ++s) {
@@ -136,6 +140,8 @@ int main(int argc, char** argv) {
         o.energy_change = info.energy_after - info.energy_before;
         o.converged = info.converged;
         o.finite = info.finite;
+        o.error = info.error;
+        o.dt = h;
         if (!ctl.judge(o)) {
           imp->undo(rod);
           continue;

@@ -48,6 +48,8 @@ struct Config {
   int time_implicit_jacobian_every = 1;     ///< implicit: steps between stiffness refreshes
   int time_implicit_krylov_iterations = 0;  ///< implicit: GMRES iterations (0: IMEX)
   double time_implicit_krylov_tol = 1e-2;   ///< implicit: GMRES relative residual
+  int time_implicit_order = 1;              ///< implicit: 1 (IMEX Euler) or 2 (ROS2), issue 24
+  double time_error_tolerance_A = 0.1;      ///< implicit, order 2: local error per step, Å (0: off)
   // [rod]
   int rod_base_pairs = 600;                         ///< rod.base_pairs: rod points n
   int rod_excess_link = 6;                          ///< rod.excess_link: ΔLk (integer)

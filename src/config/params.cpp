@@ -91,6 +91,11 @@ void validate_one(const Config& c) {
     bad("grid.box_A", fmt(c.grid_box_A),
         "at most " + fmt(kMaxBoxPerRise) + " rod.rise_A = " + fmt(kMaxBoxPerRise * c.rod_rise_A) +
             " Å (positions of that size keep 6 digits of a segment in double precision)");
+  if (c.time_scheme == "implicit" && c.time_implicit_order == 2 &&
+      c.time_implicit_krylov_iterations > 0)
+    bad("time.implicit_krylov_iterations", std::to_string(c.time_implicit_krylov_iterations),
+        "0 with time.implicit_order = 2 (GMRES corrects the order-1 step only; set "
+        "time.implicit_order = 1)");
   if (c.time_scheme == "implicit" && c.time_dt_min_ns > c.time_dt_ns)
     bad("time.dt_min_ns", fmt(c.time_dt_min_ns),
         "at most time.dt_ns = " + fmt(c.time_dt_ns) + " ns (the implicit scheme's largest step)");
@@ -373,6 +378,9 @@ sim::SimParams to_params(const Config& c) {
   p.implicit.jacobian_every = c.time_implicit_jacobian_every;
   p.implicit.krylov_max_iter = c.time_implicit_krylov_iterations;
   p.implicit.krylov_tol = c.time_implicit_krylov_tol;
+  // issue 24: the two-stage step and its error control (order 1 has no estimate: off)
+  p.implicit.order = c.time_implicit_order;
+  p.adaptive.error_tolerance = c.time_implicit_order == 2 ? c.time_error_tolerance_A * angstrom : 0.0;
   return p;
 }
 

@@ -394,6 +394,14 @@ const std::vector<Key>& schema() {
       real("time.implicit_krylov_tol", &Config::time_implicit_krylov_tol, 0, true, 1,
            "implicit: relative residual at which GMRES stops (not reached: the step is retried "
            "shorter)"),
+      integer("time.implicit_order", &Config::time_implicit_order, 1, 2,
+              "implicit: 1 (the linearly implicit IMEX Euler step, one Stokes solve a step; the "
+              "default) or 2 (two-stage Rosenbrock-W, ROS2: second order, an error estimate and "
+              "error control, two solves a step; docs/large_dt.md)"),
+      real("time.error_tolerance_A", &Config::time_error_tolerance_A, 0, false, 1e4,
+           "implicit, order 2: largest local error estimate of a step, Å (a rod point's position, "
+           "a triad's turn times steric.diameter_A/2); Δt follows it, time.dt_ns is the cap "
+           "(0: no error control)"),
       integer("rod.base_pairs", &Config::rod_base_pairs, 8, 1000000, "rod points = base pairs n"),
       integer("rod.excess_link", &Config::rod_excess_link, -1000, 1000,
               "excess link ΔLk of the initial circle, an integer"),

@@ -12,6 +12,8 @@
 // Rejection multiplies Δt by `shrink` (and by less if the displacement says so); after
 // `grow_after` accepted steps in a row Δt grows by `grow`, never above dt_max. Units: s, Å, rad,
 // g Å² s⁻² (any consistent set).
+// With error_tolerance > 0 (error control, issue 24) a step is also rejected when its local
+// error estimate exceeds the tolerance, and Δt follows the estimate instead of the fixed growth.
 namespace ibrod::integrate {
 
 struct AdaptiveDtParams {
@@ -20,6 +22,11 @@ struct AdaptiveDtParams {
   double max_displacement = 1.0;  ///< largest |δX_k| per step, Å
   double max_rotation = 0.2;      ///< largest |δθ_k| per step, rad
   double energy_tolerance = 0.0;  ///< allowed rise of the potential energy per step
+  /// largest local error estimate per step (StepOutcome::error, Å); 0: no error control. With
+  /// it, Δt follows the estimate (error ∝ Δt² for the embedded first-order estimate):
+  /// Δt ← Δt · clamp(0.9 √(tol/err), 0.2, grow_max), rejecting steps with err > tol
+  double error_tolerance = 0.0;
+  double grow_max = 2.0;  ///< largest growth factor of one step under error control
   double shrink = 0.5;            ///< Δt factor on rejection
   double grow = 1.25;             ///< Δt factor after grow_after accepted steps
   int grow_after = 4;
@@ -30,6 +37,8 @@ struct StepOutcome {
   double max_displacement = 0;  ///< Å
   double max_rotation = 0;      ///< rad
   double energy_change = 0;     ///< E(qⁿ⁺¹) − E(qⁿ)
+  double error = 0;             ///< local error estimate, Å (0: none)
+  double dt = 0;                ///< the trial's Δt (0: dt(); less when the caller capped it)
   bool converged = true;
   bool finite = true;
 };

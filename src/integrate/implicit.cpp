@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -40,6 +41,10 @@ ImplicitStepper::ImplicitStepper(Stepper& stepper, const ImplicitParams& p)
   if (!(p_.mobility_scale >= 0)) throw std::invalid_argument("ImplicitStepper: mobility_scale < 0");
   if (p_.krylov_max_iter < 0) throw std::invalid_argument("ImplicitStepper: krylov_max_iter < 0");
   if (p_.jacobian_every < 1) throw std::invalid_argument("ImplicitStepper: jacobian_every < 1");
+  if (p_.order != 1 && p_.order != 2) throw std::invalid_argument("ImplicitStepper: order not 1 or 2");
+  if (p_.order == 2 && (p_.krylov_max_iter > 0 || !p_.velocity_form || !(p_.mobility_scale > 0)))
+    throw std::invalid_argument(
+        "ImplicitStepper: order 2 needs the velocity form, mobility_scale > 0 and no GMRES");
   work_.resize(n_);
   for (auto* v : {&U_, &W_, &Fa_, &Ta_, &Fb_, &Tb_}) v->assign(n_, Vec3::Zero());
 
@@ -182,9 +187,12 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
     }
     steps_since_jacobian_ = (steps_since_jacobian_ + 1) % p_.jacobian_every;
   }
-  if (local && lu_dt_ != dt) {
+  // ROS2 factorises W = I + γΔt M_loc K
+  constexpr double kGamma = 1.0 + 0.70710678118654752440;
+  const double wdt = p_.order == 2 ? kGamma * dt : dt;
+  if (local && lu_dt_ != wdt) {
     const double t0 = now();
-    factorize(dt);
+    factorize(wdt);
     timings_.factorize += now() - t0;
   }
   auto precondition = [&](const VectorXd& v) -> VectorXd {
@@ -195,10 +203,11 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
     return x;
   };
   std::vector<Vec3> aF(n), aT(n), aU(n), aW(n);
+  const std::vector<Vec3>* at = &s.X;            // where M is taken (ROS2's stage: elsewhere)
   auto apply_mobility = [&](const VectorXd& g) {  // M g: one Stokes solve
     unpack(g, aF, aT);
     const double t0 = now();
-    mobility(s.X, aF, aT, aU, aW);
+    mobility(*at, aF, aT, aU, aW);
     timings_.stokes += now() - t0;
     ++info.fluid_solves;
     VectorXd u;
@@ -218,7 +227,40 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
   };
   const bool krylov = p_.krylov_max_iter > 0;
   VectorXd u;
-  if (p_.velocity_form) {
+  if (p_.order == 2) {
+    // ROS2: W k₁ = M F(qⁿ); W k₂ = M F(qⁿ + Δt k₁) − 2 k₁; u = 3/2 k₁ + 1/2 k₂
+    const VectorXd k1 = precondition(apply_mobility(b));
+    unpack(k1, U_, W_);
+    stage_ = s;
+    rod::advance(stage_, U_, W_, dt);
+    VectorXd b2;
+    bool stage_finite = k1.allFinite();
+    if (stage_finite) {
+      try {
+        const double t0 = now();
+        st_.compute_forces(stage_);
+        timings_.forces += now() - t0;
+        pack(st_.forces(), st_.torques(), b2);
+        stage_finite = b2.allFinite();
+      } catch (const std::exception&) {  // a position out of any range: not finite
+        stage_finite = false;
+      }
+    }
+    if (!stage_finite) {
+      u = VectorXd::Constant(6 * n, std::numeric_limits<double>::quiet_NaN());
+    } else {
+      at = &stage_.X;
+      const VectorXd k2 = precondition(VectorXd(apply_mobility(b2) - 2.0 * k1));
+      at = &s.X;
+      u = 1.5 * k1 + 0.5 * k2;
+      // the embedded first-order solution qⁿ + Δt k₁ is Δt ½ (k₁ + k₂) away
+      for (int k = 0; k < n; ++k) {
+        const double ex = 0.5 * dt * (k1.segment<3>(6 * k) + k2.segment<3>(6 * k)).norm();
+        const double er = 0.5 * dt * (k1.segment<3>(6 * k + 3) + k2.segment<3>(6 * k + 3)).norm();
+        info.error = std::max({info.error, ex, p_.rotation_length * er});
+      }
+    }
+  } else if (p_.velocity_form) {
     // (I + Δt M K) u = M F, δ = Δt u; the IMEX guess u₀ = (I + Δt M_loc K)⁻¹ M F
     const VectorXd mf = apply_mobility(b);
     u = precondition(mf);
@@ -268,6 +310,7 @@ StepOutcome outcome(const ImplicitStepInfo& info) {
   o.energy_change = info.energy_after - info.energy_before;
   o.converged = info.converged;
   o.finite = info.finite;
+  o.error = info.error;
   return o;
 }
 
@@ -277,7 +320,9 @@ ImplicitStepInfo step_adaptive(ImplicitStepper& stepper, rod::RodState& s, Adapt
   for (;;) {
     const double dt = std::min(ctl.dt(), cap);
     const ImplicitStepInfo info = stepper.step(s, dt);
-    if (ctl.judge(outcome(info))) {
+    StepOutcome o = outcome(info);
+    o.dt = dt;
+    if (ctl.judge(o)) {
       if (dt_taken) *dt_taken = dt;
       if (rejected) *rejected = undone;
       return info;

@@ -47,6 +47,9 @@ struct ImplicitParams {
   /// only resumes from the periodic checkpoints are bitwise (Simulation::checkpoint_taken).
   int jacobian_every = 1;
   bool velocity_form = true;  ///< (I + Δt M_loc K) u = M F (true) or (I + Δt K M_loc) g = F
+  /// the length that turns a rotation error (rad) into a displacement of the rod's surface in the
+  /// error estimate, Å (the steric radius D/2)
+  double rotation_length = 10.0;
   bool gauss_newton = true;  ///< K = Δs Σ Jᵀ C J (positive semi-definite) instead of −∂F/∂q
   bool stiffness_fd = false;  ///< Gauss–Newton K by finite differences (else small-strain
                               ///< analytic strain Jacobian, O(n))
@@ -54,6 +57,13 @@ struct ImplicitParams {
   /// Cholesky; the same solution to round-off)
   bool block_solver = true;
   bool steric_implicit = true;  ///< add the steric contacts' stiffness to K
+  /// 1: the linearly implicit IMEX step (1) above; 2: the two-stage Rosenbrock-W step (ROS2,
+  /// Verwer et al. 1999) with the same W = I + γΔt M_loc K, γ = 1 + 1/√2:
+  ///   W k₁ = M F(qⁿ),  W k₂ = M F(qⁿ + Δt k₁) − 2 k₁,  qⁿ⁺¹ = qⁿ + Δt (3/2 k₁ + 1/2 k₂)
+  /// second order for any approximation of the Jacobian (a W-method), two Stokes solves and two
+  /// force evaluations per step, with the embedded first-order qⁿ + Δt k₁ for the error
+  /// estimate Δt ½ (k₁ + k₂) (docs/large_dt.md "Error control and order"). Velocity form only.
+  int order = 1;
   double fd_dx = 1e-4;          ///< finite-difference step of K in positions, Å
   double fd_dtheta = 1e-5;      ///< ... and in rotation vectors, rad
 };
@@ -70,6 +80,9 @@ struct ImplicitStepInfo {
   double energy_after = 0;      ///<   and at qⁿ⁺¹, g Å² s⁻²
   bool finite = true;           ///< qⁿ⁺¹ is finite
   bool jacobian_refreshed = false;
+  /// order 2: the local error estimate max_k max(|e_X,k|, ℓ_θ |e_θ,k|), Å, e = Δt ½ (k₁ + k₂)
+  /// (the distance to the embedded first-order solution), ℓ_θ = rotation_length; order 1: 0
+  double error = 0;
 };
 
 /// Wall time spent in the parts of ImplicitStepper::step, accumulated, s.
@@ -146,7 +159,7 @@ class ImplicitStepper {
   ImplicitTimings timings_;
   rod::RodWork work_;
   std::vector<Vec3> U_, W_, Fa_, Ta_, Fb_, Tb_;
-  rod::RodState pert_;
+  rod::RodState pert_, stage_;
   // forces at the state `cur_` (valid if has_cur_), and at the state before the latest step
   struct Cached {
     rod::RodState q;

@@ -94,6 +94,9 @@ SimParams checked(SimParams p) {
       if (p.stepper.steric.enabled) range = std::min(range, p.stepper.steric.diameter);
       a.max_displacement = 0.2 * range;
     }
+    // the error estimate counts a triad's turn as the move of the rod's surface (issue 24)
+    if (p.stepper.steric.enabled && p.stepper.steric.diameter > 0)
+      p.implicit.rotation_length = 0.5 * p.stepper.steric.diameter;
   }
   return p;
 }

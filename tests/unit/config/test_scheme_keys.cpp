@@ -20,6 +20,7 @@ TEST(SchemeKeys, ExplicitByDefaultImplicitOnRequest) {
   config::apply_override(c, "time.implicit_jacobian_every=2");
   config::apply_override(c, "time.implicit_krylov_iterations=5");
   config::validate(c);
+  EXPECT_EQ(config::to_params(c).implicit.order, 1);  // the default: the IMEX Euler step
   const sim::SimParams p = config::to_params(c);
   EXPECT_EQ(p.scheme, sim::TimeScheme::implicit_step);
   EXPECT_DOUBLE_EQ(p.adaptive.max_displacement, 1.5);
@@ -51,4 +52,30 @@ TEST(SchemeKeys, AnUnknownSchemeOrABadKnobNamesTheKey) {
   config::apply_override(c, "time.scheme=\"implicit\"");
   config::apply_override(c, "time.dt_min_ns=1");  // above time.dt_ns = 0.1
   EXPECT_THROW(config::validate(c), ConfigError);
+}TEST(SchemeKeys, OrderTwoAndItsErrorToleranceReachTheParameters) {
+  config::Config c;
+  config::apply_override(c, "time.scheme=\"implicit\"");
+  config::apply_override(c, "time.implicit_order=2");
+  config::apply_override(c, "time.error_tolerance_A=0.05");
+  config::validate(c);
+  sim::SimParams p = config::to_params(c);
+  EXPECT_EQ(p.implicit.order, 2);
+  EXPECT_DOUBLE_EQ(p.adaptive.error_tolerance, 0.05);
+  // order 1 has no estimate: no error control
+  config::apply_override(c, "time.implicit_order=1");
+  EXPECT_EQ(config::to_params(c).adaptive.error_tolerance, 0.0);
+  // GMRES corrects the order-1 step only: refused with order 2, naming the key
+  config::apply_override(c, "time.implicit_order=2");
+  config::apply_override(c, "time.implicit_krylov_iterations=3");
+  try {
+    config::validate(c);
+    ADD_FAILURE() << "order 2 with GMRES accepted";
+  } catch (const std::exception& e) {
+    EXPECT_THAT(e.what(), HasSubstr("time.implicit_krylov_iterations"));
+    EXPECT_THAT(e.what(), HasSubstr("time.implicit_order"));
+  }
+  config::apply_override(c, "time.implicit_krylov_iterations=0");
+  EXPECT_THROW(config::apply_override(c, "time.implicit_order=3"), std::exception);
 }
+
+

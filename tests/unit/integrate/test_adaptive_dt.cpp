@@ -113,5 +113,62 @@ TEST(AdaptiveDt, RejectsInconsistentParameters) {
   EXPECT_THROW(AdaptiveDt(params(), 0.0, 0), std::invalid_argument);
 }
 
+
+// ---- error control (issue 24): Δt follows the local error estimate, err ∝ Δt²
+TEST(AdaptiveDt, ErrorControlRejectsAboveTheToleranceAndShrinksBySquareRoot) {
+  AdaptiveDtParams p = params();
+  p.error_tolerance = 0.1;
+  AdaptiveDt c(p);
+  StepOutcome o = good();
+  o.error = 0.4;  // 4× the tolerance: reject, next Δt = 0.9 √(1/4) = 0.45 of the step
+  EXPECT_FALSE(c.judge(o));
+  EXPECT_NEAR(c.dt(), 2e-9 * 0.45, 1e-20);
+  o.error = 100.0;  // never below 0.2 of the step at once
+  EXPECT_FALSE(c.judge(o));
+  EXPECT_NEAR(c.dt(), 2e-9 * 0.45 * 0.2, 1e-20);
+  EXPECT_EQ(c.rejections(), 2);
+  // without error control the same estimate is ignored
+  AdaptiveDt off(params());
+  EXPECT_TRUE(off.judge(o));
+}
+
+TEST(AdaptiveDt, ErrorControlGrowsTowardTheToleranceNotPastTheCap) {
+  AdaptiveDtParams p = params();
+  p.error_tolerance = 0.1;
+  p.dt_max = 1e-8;
+  AdaptiveDt c(p, 1e-9, 5);
+  StepOutcome o = good();
+  o.error = 0.1 / 1.44;  // asks for 0.9 × 1.2 = 1.08
+  EXPECT_TRUE(c.judge(o));
+  EXPECT_NEAR(c.dt(), 1.08e-9, 1e-20);
+  o.error = 1e-9;  // asks for a lot: at most grow_max (2)
+  EXPECT_TRUE(c.judge(o));
+  EXPECT_NEAR(c.dt(), 2.16e-9, 1e-20);
+  for (int i = 0; i < 10; ++i) EXPECT_TRUE(c.judge(o));
+  EXPECT_EQ(c.dt(), 1e-8);  // dt_max is the cap
+  o.error = 0.1;            // at the tolerance: accepted, and Δt shrinks to 0.9
+  EXPECT_TRUE(c.judge(o));
+  EXPECT_NEAR(c.dt(), 0.9e-8, 1e-20);
+}
+
+TEST(AdaptiveDt, ErrorControlAfterARejectionAndForAShortenedStep) {
+  AdaptiveDtParams p = params();
+  p.error_tolerance = 0.1;
+  AdaptiveDt c(p);
+  StepOutcome o = good();
+  o.error = 0.4;
+  EXPECT_FALSE(c.judge(o));  // dt = 0.9e-9
+  o.error = 1e-6;            // right after a rejection: accepted, no growth
+  EXPECT_TRUE(c.judge(o));
+  EXPECT_NEAR(c.dt(), 0.9e-9, 1e-20);
+  // a step the caller shortened (o.dt < dt()) keeps dt() unless its own error asks for less
+  o.dt = 1e-11;
+  EXPECT_TRUE(c.judge(o));
+  EXPECT_NEAR(c.dt(), 0.9e-9, 1e-20);
+  o.error = 0.1 * 16;  // too large even for the short step: rejected, 0.9/4 of the short step
+  EXPECT_FALSE(c.judge(o));
+  EXPECT_NEAR(c.dt(), 1e-11 * 0.225, 1e-22);
+}
+
 }  // namespace
 }  // namespace ibrod::integrate

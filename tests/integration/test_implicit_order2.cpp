@@ -1,0 +1,164 @@
+// The implicit scheme's second-order step, its error control and its stiff modes (issue 24,
+// docs/large_dt.md "Error control, order and stiff modes") on the small ring of
+// test_implicit.cpp: 16³ grid (h = 12.5 Å), 100 bp, 0.1 M, electrostatics and steric on.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include "config/config.hpp"
+#include "helpers.hpp"
+#include "integrate/implicit.hpp"
+
+namespace ibrod {
+namespace {
+
+struct Ring {
+  sim::SimParams p;
+  rod::RodState rod;
+  std::unique_ptr<integrate::Stepper> st;
+  std::unique_ptr<integrate::ImplicitStepper> imp;
+  explicit Ring(double beta, int order = 1, int excess_link = 3,
+                std::vector<double> perturbation = {1.0}) {
+    config::Config c = test::small_config(excess_link);
+    c.run_threads = 1;
+    c.rod_perturbation = perturbation;
+    p = config::to_params(c);
+    rod = rod::twisted_circle(p.stepper.rod, p.circle);
+    st = std::make_unique<integrate::Stepper>(p.stepper);
+    integrate::ImplicitParams ip;
+    ip.mobility_scale = beta;  // 0: the explicit Stokes-limit Euler step δ = Δt M F
+    ip.order = order;
+    imp = std::make_unique<integrate::ImplicitStepper>(*st, ip);
+  }
+  void run(double dt, double t_end) {
+    const long n = std::lround(t_end / dt);
+    for (long k = 0; k < n; ++k) imp->step(rod, dt);
+  }
+  double potential_kT() {  // the energy at the current state (one more step's forces)
+    return imp->step(rod, 0.0).energy_before / p.kT;
+  }
+};
+
+double max_distance(const rod::RodState& a, const rod::RodState& b) {
+  double d = 0;
+  for (int k = 0; k < a.size(); ++k) d = std::max(d, (a.X[k] - b.X[k]).norm());
+  return d;
+}
+
+TEST(ImplicitOrder2, SecondOrderConvergenceAndItsEmbeddedEstimate) {
+  // 20 ns of the buckling ΔLk = 3 ring at Δt = 0.4, 0.2, 0.1 ns against the same ROS2 step at
+  // 0.025 ns (ROS2 is a W-method: second order for any M_loc; the first-order IMEX step's
+  // error against this reference halves with Δt, test_implicit.cpp).
+  const double T = 20e-9;
+  Ring ref(8.0, 2);
+  ref.run(0.025e-9, T);
+  double err[3], err1[3];
+  for (int i = 0; i < 3; ++i) {
+    const double dt = 0.4e-9 / (1 << i);
+    Ring r(8.0, 2), r1(8.0, 1);
+    r.run(dt, T);
+    r1.run(dt, T);
+    err[i] = max_distance(r.rod, ref.rod);
+    err1[i] = max_distance(r1.rod, ref.rod);
+    std::printf("dt = %.2f ns: ROS2 %.4g A, IMEX Euler %.4g A\n", dt * 1e9, err[i], err1[i]);
+  }
+  // measured: ROS2 1.45, 0.636, 0.239 Å (ratios 2.28, 2.66: order reduction on this stiff
+  // problem with an inexact Jacobian, the observed order rising from 1.2 to 1.4 toward 2);
+  // IMEX Euler 1.79, 0.947, 0.471 Å (ratios 1.89, 2.01)
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_LT(err[i], err1[i]) << i;
+    EXPECT_LT(err1[i] / err1[i + 1], 2.2) << i;  // first order
+  }
+  EXPECT_GT(err[1] / err[2], 2.4);  // above first order, and rising as Δt falls
+  EXPECT_GT(err[1] / err[2], err[0] / err[1]);
+  EXPECT_LT(err[2], 0.6 * err1[2]);
+  // the estimate is first order in the step's length: ~4× per halving of a single step
+  Ring a(8.0, 2), b(8.0, 2);
+  a.run(0.1e-9, 10e-9);
+  b.rod = a.rod;
+  const double e1 = a.imp->step(a.rod, 0.4e-9).error;
+  const double e2 = b.imp->step(b.rod, 0.2e-9).error;
+  EXPECT_GT(e1, 0);
+  EXPECT_GT(e1 / e2, 3.0);
+  EXPECT_LT(e1 / e2, 5.0);
+}
+
+TEST(ImplicitOrder2, StiffModesDecayWhereTheLocalMobilityIsTooSmall) {
+  // An untwisted ring with a large shape perturbation relaxing to its circle at Δt far beyond
+  // the explicit limit (~0.15 ns) with β = 2: M_loc underestimates the collective mobility of
+  // the long modes by more than 2×, where the order-1 step's amplification 1 − r x/(1 + x)
+  // passes below −1 (a period-2 oscillation that grows). ROS2's stays within (−1, 1) up to
+  // r = 2γ ≈ 3.4: every mode decays, the energy falls at every step.
+  for (double dt : {1e-9, 2e-9, 4e-9}) {
+    Ring r(2.0, 2, 0, {3.0});
+    const double e0 = r.potential_kT();
+    double prev = e0;
+    for (int k = 0; k < 40; ++k) {
+      const auto info = r.imp->step(r.rod, dt);
+      ASSERT_TRUE(info.finite) << dt << " step " << k;
+      const double e = info.energy_after / r.p.kT;
+      ASSERT_LE(e, prev + 1e-6) << "dt = " << dt << " step " << k;
+      prev = e;
+    }
+    EXPECT_LT(prev, e0 - 50) << dt;  // it relaxed (measured 191.6 → 76.1 kT)
+  }
+  // the order-1 step on the same ring at 4 ns does not decay: its energy rises or it blows up
+  Ring r1(2.0, 1, 0, {3.0});
+  double prev = r1.potential_kT();
+  bool rose = false;
+  for (int k = 0; k < 40 && !rose; ++k) {
+    integrate::ImplicitStepInfo info;
+    try {
+      info = r1.imp->step(r1.rod, 4e-9);
+    } catch (const std::exception&) {  // the local system of a blown-up state
+      rose = true;
+      break;
+    }
+    rose = !info.finite || info.energy_after / r1.p.kT > prev + 1e-6;
+    prev = info.energy_after / r1.p.kT;
+  }
+  EXPECT_TRUE(rose);
+}
+
+double run_adaptive(Ring& r, double dt_max, double tol, double t_end) {
+  integrate::AdaptiveDtParams ap;
+  ap.dt_max = dt_max;
+  ap.dt_min = 1e-3 * dt_max;
+  ap.max_displacement =
+      0.2 * std::min(1 / r.p.stepper.electro.law.kappa, r.p.stepper.steric.diameter);
+  ap.energy_tolerance = 1e-6 * r.p.kT;
+  ap.error_tolerance = tol;
+  integrate::AdaptiveDt ctl(ap);
+  double t = 0;
+  while (t < t_end) {
+    double dt = 0;
+    integrate::step_adaptive(*r.imp, r.rod, ctl, t_end - t, &dt);
+    t += dt;
+  }
+  return r.potential_kT();
+}
+
+TEST(ImplicitOrder2, ErrorControlFollowsTheExplicitPathWhereTheFixedCapDoesNot) {
+  // ΔLk = 4 collapses within ~50 ns; at the README's cap (2 ns) the order-1 scheme takes the
+  // collapse in ~25 steps and lands in a figure-8 ~30 kT below the explicit scheme's toroid
+  // (ibrod compare, docs/analysis.md). ROS2 with the default error tolerance (0.1 Å) shortens
+  // the steps through the collapse and ends in the explicit basin (measured at 300 ns: explicit
+  // 312.5 kT, ROS2 with error control 311.6, order 1 at 2 ns 295.3).
+  const double T = 150e-9;
+  Ring ex(0.0, 1, 4);
+  ex.run(0.1e-9, T);
+  const double e_ex = ex.potential_kT();
+  Ring r2(8.0, 2, 4), r1(8.0, 1, 4);
+  const double e2 = run_adaptive(r2, 2e-9, 0.1, T);
+  const double e1 = run_adaptive(r1, 2e-9, 0.0, T);
+  std::printf("E at 150 ns: explicit %.3f, ROS2 + error control %.3f, order 1 %.3f kT\n", e_ex,
+              e2, e1);
+  EXPECT_NEAR(e2, e_ex, 2.0);
+  EXPECT_GT(std::abs(e1 - e_ex), 5.0);  // today's default cap: another state
+}
+
+}  // namespace
+}  // namespace ibrod
