@@ -11,6 +11,7 @@
 #include <optional>
 #include <sstream>
 
+#include "config/config.hpp"
 #include "core/error.hpp"
 #include "core/text_file.hpp"
 #include "diagnostics/topology.hpp"
@@ -61,6 +62,26 @@ RodFrame read_final_state(const fs::path& dir) {
     f.d1.emplace_back(a[k], b[k], c[k]);
   }
   if (f.X.size() < 2) throw ConfigError("'" + s.path.string() + "' holds fewer than 2 points");
+  // a file cut short (a copy broken off, a disk that filled) is no shape to draw: its rows must be
+  // the run's rod points (config.toml), the last one whole
+  const fs::path cfg = RunDir(dir).config();
+  if (fs::exists(cfg)) {
+    int points = -1;
+    try {
+      points = config::point_count(config::load_config(cfg.string()));
+    } catch (const ConfigError&) {
+      // a config.toml that cannot be read: only the file's own shape is checked
+    }
+    const std::string text = read_text_file(s.path, "render");
+    if ((points > 0 && int(f.X.size()) != points) || text.empty() || text.back() != '\n')
+      throw ConfigError(
+          "'" + s.path.string() + "' is truncated or damaged: it holds " +
+          std::to_string(f.X.size()) + " whole rows" +
+          (points > 0 ? ", the run has " + std::to_string(points) + " rod points (config.toml)"
+                      : std::string()) +
+          (!text.empty() && text.back() != '\n' ? ", and its last line is cut off"
+                                                : std::string()));
+  }
   // its time: summary.json, else the last row of timeseries.csv
   f.time_us = std::numeric_limits<double>::quiet_NaN();
   const fs::path sp = RunDir(dir).summary();
