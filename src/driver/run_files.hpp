@@ -148,9 +148,9 @@ class RunFiles {
     throw RunError("output: the run directory " + dir_.root().string() +
                    " was deleted or moved while the run was writing it (noticed at step " +
                    std::to_string(step) +
-                   "); the run stops here, since nothing it wrote on could be found. If it was "
-                   "moved, continue it where it is now with --resume NEWDIR; if it was deleted, "
-                   "there is no checkpoint left to --resume from: start the run again");
+                   "); the run stops here rather than write where nobody would find it. If it "
+                   "was moved, continue it where it is now with --resume NEWDIR; if it was "
+                   "deleted, there is no checkpoint left to --resume from: start the run again");
   }
 
   void row(const sim::Observables& o) {
