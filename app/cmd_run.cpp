@@ -107,6 +107,8 @@ int run_main(RunArgs a) {
 int check_main(const ConfigArgs& a) {
   try {
     const cfg::Config c = resolve(a);
+    // rod.initial_shape and the rods' start together, checked as `ibrod run` checks them
+    driver::read_initial_shapes(c);
     std::printf("# resolved configuration\n%s\n# derived quantities\n%s", cfg::describe(c).c_str(),
                 cfg::derived_report(c).c_str());
     for (const std::string& w : cfg::check_warnings(c)) std::printf("# warning: %s\n", w.c_str());

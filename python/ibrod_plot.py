@@ -16,10 +16,12 @@ labelled ticks (1-2-5 ticks or a widened range when the data span less than a de
 Needs numpy and matplotlib (Debian: python3-numpy python3-matplotlib); use /usr/bin/python3.
 """
 import argparse
+import io
 import json
 import os
 import sys
 import tomllib
+import warnings
 
 import matplotlib
 
@@ -92,6 +94,28 @@ def grid_text(config):
     return text + (f", box {g['box_A']:g} Å" if "box_A" in g else "")
 
 
+def read_csv(path):
+    """A run's CSV (timeseries.csv) as a numpy structured array. A last row cut short by a killed
+    run (no newline at its end) is dropped, as `ibrod analyze` drops it; a file that still cannot
+    be read stops with a message naming it."""
+    try:
+        with open(path, encoding="utf-8") as f:
+            text = f.read()
+    except (OSError, UnicodeDecodeError) as e:
+        raise SystemExit(f"ibrod_plot: cannot read {path}: {e}")
+    if text and not text.endswith("\n"):
+        text = text[: text.rfind("\n") + 1]
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # a header without rows: an empty table
+            a = np.atleast_1d(np.genfromtxt(io.StringIO(text), delimiter=",", names=True))
+    except ValueError as e:
+        raise SystemExit(f"ibrod_plot: cannot read {path}: {e}")
+    if a.dtype.names is None:
+        raise SystemExit(f"ibrod_plot: cannot read {path}: no header line of column names")
+    return a
+
+
 class Run:
     """One run directory: its time series, config and (possibly analysed) summary."""
 
@@ -101,17 +125,23 @@ class Run:
         ts_path = os.path.join(path, "timeseries.csv")
         if not os.path.isfile(ts_path):
             raise SystemExit(f"ibrod_plot: {ts_path} not found (is {path} an ibrod run directory?)")
-        self.ts = np.atleast_1d(np.genfromtxt(ts_path, delimiter=",", names=True))
+        self.ts = read_csv(ts_path)
         self.config = {}
         cfg_path = os.path.join(path, "config.toml")
         if os.path.isfile(cfg_path):
-            with open(cfg_path, "rb") as f:
-                self.config = tomllib.load(f)
+            try:
+                with open(cfg_path, "rb") as f:
+                    self.config = tomllib.load(f)
+            except (OSError, ValueError) as e:
+                raise SystemExit(f"ibrod_plot: cannot read {cfg_path}: {e}")
         self.summary = {}
         sum_path = os.path.join(path, "summary.json")
         if os.path.isfile(sum_path):
-            with open(sum_path) as f:
-                self.summary = json.load(f)
+            try:
+                with open(sum_path) as f:
+                    self.summary = json.load(f)
+            except (OSError, ValueError) as e:
+                raise SystemExit(f"ibrod_plot: cannot read {sum_path}: {e}")
 
     @property
     def excess_link(self):

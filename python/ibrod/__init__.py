@@ -13,11 +13,13 @@ The same C++ core as the command line `ibrod` (docs/python.md)::
 
 Import it with the build's python folder on the path: PYTHONPATH=build/python.
 """
+import io
 import json
 import math
 import numbers
 import os
 import tomllib
+import warnings
 
 import numpy as np
 
@@ -104,12 +106,35 @@ class Simulation(_CoreSimulation):
         return c
 
 
+def _damaged(path, e):
+    """A file of a run that cannot be read: a ValueError naming it (the cause chained)."""
+    return ValueError(f"read_run: {path} cannot be read: {e}")
+
+
 def _read_csv(path):
-    a = np.genfromtxt(path, delimiter=",", names=True, dtype=float)
+    """A CSV of a run as dict column -> array. A last row cut short by a killed run (no newline at
+    its end) is dropped, as `ibrod analyze` and `--resume` drop it."""
+    try:
+        with open(path, encoding="utf-8") as fh:
+            text = fh.read()
+    except (OSError, UnicodeDecodeError) as e:
+        raise _damaged(path, e) from e
+    if text and not text.endswith("\n"):
+        text = text[: text.rfind("\n") + 1]
+    if not text.strip():
+        raise _damaged(path, "it is empty (no header line)")
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # a header without rows: an empty table
+            a = np.genfromtxt(io.StringIO(text), delimiter=",", names=True, dtype=float)
+    except ValueError as e:
+        raise _damaged(path, e) from e
     a = np.atleast_1d(a)
+    if a.dtype.names is None:
+        raise _damaged(path, "no header line of column names")
     out = {n: np.asarray(a[n]) for n in a.dtype.names}
     if "step" in out:
-        out["step"] = out["step"].astype(np.int64)
+        out["step"] = np.nan_to_num(out["step"]).astype(np.int64)
     return out
 
 
@@ -132,11 +157,17 @@ def read_run(path):
                      writhe_r, twist_r, link_r of each rod r); None for one rod
       "summary":     summary.json as a dict, or None
       "config":      config.toml as a dict (section -> key -> value)
-    Missing directory: FileNotFoundError.
+    Missing directory, or one that holds none of these files: FileNotFoundError. A file that
+    cannot be read (damaged, cut short, not what its name says): ValueError naming the file.
     """
     path = os.fspath(path)
     if not os.path.isdir(path):
         raise FileNotFoundError(f"read_run: {path} is not a directory")
+    names = ("timeseries.csv", "trajectory.h5", "final_state.csv", "summary.json", "config.toml",
+             "rods.csv")
+    if not any(os.path.exists(os.path.join(path, n)) for n in names):
+        raise FileNotFoundError(f"read_run: {path} holds none of a run's files ({', '.join(names)})"
+                                ": it is not the output directory of a run")
     out = {"timeseries": None, "frames": None, "final_state": None, "summary": None,
            "config": None, "rods": None}
     p = os.path.join(path, "rods.csv")
@@ -149,33 +180,46 @@ def read_run(path):
     if os.path.exists(p):
         f = _read_csv(p)
         col = lambda *names: np.stack([f[n] for n in names], axis=-1)
-        out["final_state"] = {
-            "positions": col("x_A", "y_A", "z_A"),
-            "triads": _triads(col("d1x", "d1y", "d1z"), col("d2x", "d2y", "d2z"),
-                              col("d3x", "d3y", "d3z")),
-        }
+        try:
+            out["final_state"] = {
+                "positions": col("x_A", "y_A", "z_A"),
+                "triads": _triads(col("d1x", "d1y", "d1z"), col("d2x", "d2y", "d2z"),
+                                  col("d3x", "d3y", "d3z")),
+            }
+        except KeyError as e:
+            raise _damaged(p, f"no column {e}") from e
         if "rod" in f:
             out["final_state"]["rod"] = f["rod"].astype(int)
     p = os.path.join(path, "summary.json")
     if os.path.exists(p):
-        with open(p) as fh:
-            out["summary"] = json.load(fh)
+        try:
+            with open(p) as fh:
+                out["summary"] = json.load(fh)
+        except (OSError, ValueError) as e:  # json.JSONDecodeError, UnicodeDecodeError
+            raise _damaged(p, e) from e
     p = os.path.join(path, "config.toml")
     if os.path.exists(p):
-        with open(p, "rb") as fh:
-            out["config"] = tomllib.load(fh)
+        try:
+            with open(p, "rb") as fh:
+                out["config"] = tomllib.load(fh)
+        except (OSError, ValueError) as e:  # tomllib.TOMLDecodeError
+            raise _damaged(p, e) from e
     p = os.path.join(path, "trajectory.h5")
     if os.path.exists(p):
         import h5py
 
         # without file locking, as ibrod writes it (io/h5md.cpp): a Simulation of this process
         # may hold the file open
-        with h5py.File(p, "r", locking=False) as h:
-            rod = h["particles/rod"]
-            out["frames"] = {
-                "step": rod["position/step"][()],
-                "time_us": rod["position/time"][()],
-                "positions": rod["position/value"][()],
-                "triads": _triads(rod["d1/value"][()], rod["d2/value"][()], rod["d3/value"][()]),
-            }
+        try:
+            with h5py.File(p, "r", locking=False) as h:
+                rod = h["particles/rod"]
+                out["frames"] = {
+                    "step": rod["position/step"][()],
+                    "time_us": rod["position/time"][()],
+                    "positions": rod["position/value"][()],
+                    "triads": _triads(rod["d1/value"][()], rod["d2/value"][()],
+                                      rod["d3/value"][()]),
+                }
+        except (OSError, KeyError, ValueError) as e:  # h5py: not HDF5, truncated, no such group
+            raise _damaged(p, e) from e
     return out

@@ -3,8 +3,9 @@
 // (driver::Run step by step: the same loop, files and checks as `ibrod run`). The time loop runs
 // in C++ with the GIL released; Ctrl-C is seen every 0.1 s of wall time and stops the run as
 // SIGINT stops `ibrod run` (checkpoint and final files when writing a directory), then raises
-// KeyboardInterrupt. ConfigError and RunError become ibrod.ConfigError (a ValueError) and
-// ibrod.RunError (a RuntimeError) with the CLI's messages.
+// KeyboardInterrupt; a SIGTERM during run() stops it the same way, then raises SystemExit(143).
+// ConfigError and RunError become ibrod.ConfigError (a ValueError) and ibrod.RunError (a
+// RuntimeError) with the CLI's messages.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -38,6 +39,32 @@ std::string shape_text(const py::array& a) {
 }
 
 using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+// SIGTERM while run() advances a simulation: a batch system's way to end a job. Python leaves it
+// at its default (the process dies at once: no checkpoint, no final files), so while the loop
+// runs a handler of ours sets a flag the loop reads before each step, and the segment stops as
+// on Ctrl-C; run() then raises SystemExit(143). A handler the program set itself
+// (signal.signal) is left alone: PyErr_CheckSignals runs it.
+volatile std::sig_atomic_t g_sigterm = 0;
+void on_sigterm(int) { g_sigterm = 1; }
+
+struct SigtermGuard {
+  bool installed = false;
+  struct sigaction old {};
+  SigtermGuard() {
+    if (sigaction(SIGTERM, nullptr, &old) != 0 || old.sa_handler != SIG_DFL) return;
+    struct sigaction sa {};
+    sigemptyset(&sa.sa_mask);
+    sa.sa_handler = on_sigterm;
+    sa.sa_flags = SA_RESTART;
+    g_sigterm = 0;
+    installed = sigaction(SIGTERM, &sa, nullptr) == 0;
+  }
+  ~SigtermGuard() {
+    if (installed) sigaction(SIGTERM, &old, nullptr);
+  }
+  bool pending() const { return installed && g_sigterm != 0; }
+};
 
 // One trajectory driven from Python: a driver::Run prepared at construction.
 class PySimulation {
@@ -95,16 +122,23 @@ class PySimulation {
         explicit Running(std::atomic<bool>& f) : flag(f) { flag = true; }
         ~Running() { flag = false; }
       } running(running_);
+      const SigtermGuard sigterm;
       py::gil_scoped_release release;
       using Clock = std::chrono::steady_clock;
       auto last = Clock::now();
-      r = run_->advance(max_steps, [&last]() -> int {
+      r = run_->advance(max_steps, [&last, &sigterm]() -> int {
+        if (sigterm.pending()) return SIGTERM;
         const auto now = Clock::now();
         if (now - last < std::chrono::milliseconds(100)) return 0;
         last = now;
         py::gil_scoped_acquire acquire;
         return PyErr_CheckSignals() != 0 ? SIGINT : 0;
       });
+    }
+    if (r.signal == SIGTERM) {
+      // stopped as `ibrod run` stops on SIGTERM (checkpoint, final files): exit status 143
+      PyErr_SetObject(PyExc_SystemExit, py::int_(128 + SIGTERM).ptr());
+      throw py::error_already_set();
     }
     if (r.signal) throw py::error_already_set();  // KeyboardInterrupt (set by PyErr_CheckSignals)
     py::dict d;

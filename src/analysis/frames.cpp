@@ -1,6 +1,7 @@
 // The rod's frames of a run directory (final_state.csv, trajectory.h5) and `ibrod render`.
 #include "analysis/frames.hpp"
 
+#include <toml++/toml.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -11,6 +12,8 @@
 #include <optional>
 #include <sstream>
 
+#include "config/config.hpp"
+#include "config/toml_error.hpp"
 #include "core/error.hpp"
 #include "core/text_file.hpp"
 #include "diagnostics/topology.hpp"
@@ -61,6 +64,30 @@ RodFrame read_final_state(const fs::path& dir) {
     f.d1.emplace_back(a[k], b[k], c[k]);
   }
   if (f.X.size() < 2) throw ConfigError("'" + s.path.string() + "' holds fewer than 2 points");
+  // a file cut short (a copy broken off, a disk that filled) is no shape to draw: its last line
+  // whole, and its rows the run's rod points where config.toml gives their number (a run's
+  // config.toml has every key; a hand-made one may not)
+  int points = -1;
+  const fs::path cfg = RunDir(dir).config();
+  if (fs::exists(cfg)) {
+    try {
+      const std::string ct = read_text_file(cfg, "render");
+      const toml::table tbl = config::parse_toml(ct, cfg.string(), "render");
+      if (tbl["rod"]["base_pairs"] || tbl["rods"])
+        points = config::point_count(config::load_config(cfg.string()));
+    } catch (const ConfigError&) {
+      // a config.toml that cannot be read: only the file's own shape is checked
+    }
+  }
+  const std::string text = read_text_file(s.path, "render");
+  const bool cut = text.empty() || text.back() != '\n';
+  if ((points > 0 && int(f.X.size()) != points) || cut)
+    throw ConfigError("'" + s.path.string() + "' is truncated or damaged: it holds " +
+                      std::to_string(f.X.size()) + " whole rows" +
+                      (points > 0
+                           ? ", the run has " + std::to_string(points) + " rod points (config.toml)"
+                           : std::string()) +
+                      (cut ? ", and its last line is cut off" : std::string()));
   // its time: summary.json, else the last row of timeseries.csv
   f.time_us = std::numeric_limits<double>::quiet_NaN();
   const fs::path sp = RunDir(dir).summary();

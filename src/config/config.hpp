@@ -73,6 +73,9 @@ struct Config {
   /// "rod.", its value as TOML text) set on top of the [rod] keys; empty: one rod, [rod] itself.
   /// rod_config() resolves a table into the Config of that rod.
   std::vector<std::vector<std::pair<std::string, std::string>>> rods;
+  /// At most this many [[rods]] tables: each pair of rods has its own linking number (rods.csv),
+  /// so the outputs and the pair checks grow as the square of the count.
+  static constexpr std::size_t kMaxRods = 1000;
   // [solvent]
   double solvent_salt_M = 0.1;  ///< Cs, mol/L
   double solvent_viscosity_poise = 0.01;

@@ -10,6 +10,7 @@
 
 #include "config/config.hpp"
 #include "config/detail.hpp"
+#include "core/text_file.hpp"
 #include "core/units.hpp"
 #include "interactions/interactions.hpp"
 #include "rod/rod.hpp"
@@ -173,8 +174,11 @@ std::vector<std::vector<double>> read_rows(
     const std::string& what,
     const std::function<std::string(const std::vector<double>&)>& row_problem) {
   std::vector<std::vector<double>> out;
-  std::ifstream in(path);
-  if (!in) bad(key, path, "a readable file (cannot open it)");
+  // a regular file only: a FIFO would block for ever, /dev/zero fill the memory, a directory read
+  // as empty (refused before it is opened; core/text_file.hpp)
+  if (const std::string why = unreadable_reason(path); !why.empty())
+    bad(key, "\"" + path + "\"", "a readable regular file (" + why + ")");
+  std::istringstream in(read_text_file(path, key));
   std::string line;
   int line_no = 0;
   while (std::getline(in, line)) {

@@ -575,6 +575,11 @@ void set_rod_tables(Config& c, const toml::node& node) {
     throw ConfigError(
         "config: 'rods' must be an array of tables, one [[rods]] table per rod, each with keys "
         "of [rod] (docs/config.md \"Several rods\")");
+  if (a->size() > Config::kMaxRods)
+    throw ConfigError("config: rods = " + std::to_string(a->size()) +
+                      " [[rods]] tables is invalid: expected at most " +
+                      std::to_string(Config::kMaxRods) +
+                      " (one table per rod; docs/config.md \"Several rods\")");
   c.rods.clear();
   for (std::size_t r = 0; r < a->size(); ++r) {
     c.rods.emplace_back();
@@ -668,11 +673,12 @@ void apply_override(Config& c, const std::string& assignment) {
     const auto [end, ec] =
         std::from_chars(rest.data(), rest.data() + std::min(dot, rest.size()), r);
     if (dot == std::string::npos || ec != std::errc() || end != rest.data() + dot ||
-        r > c.rods.size())
+        r > c.rods.size() || r >= Config::kMaxRods)
       throw ConfigError("config: --set " + echo(key) +
                         ": a [[rods]] key is rods.K.key with K a table number from 0 to " +
-                        std::to_string(c.rods.size()) + " (" + std::to_string(c.rods.size()) +
-                        " appends a table)");
+                        std::to_string(std::min(c.rods.size(), Config::kMaxRods - 1)) + " (" +
+                        std::to_string(c.rods.size()) + " appends a table; at most " +
+                        std::to_string(Config::kMaxRods) + " rods)");
     set_rod_key(c, r, rest.substr(dot + 1), *t.get("v"));
     return;
   }

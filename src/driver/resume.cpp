@@ -77,12 +77,31 @@ void Run::State::open_checkpoint() {
                         "; the configuration asks for rod.closed = " +
                         (c.rod_closed ? "true" : "false") + ": incompatible, even with --force");
   }
-  const std::string diff = config::config_differences(ck.meta.config_toml, user, cp.string());
+  // the run's own checkpoint: its id is config.toml's (a checkpoint copied in from another run
+  // directory would continue that run's state under this one's files)
+  const RunStamp ck_stamp = read_stamp(ck.meta.config_toml);
+  const RunStamp dir_stamp = read_stamp(try_read_text_file(dir.config()).value_or(""));
+  if (!ck_stamp.run_id.empty() && !dir_stamp.run_id.empty() && ck_stamp.run_id != dir_stamp.run_id)
+    throw ConfigError("resume: " + cp.string() + " belongs to another run (run id " +
+                      ck_stamp.run_id + ") than " + dir.config().string() + " (run id " +
+                      dir_stamp.run_id +
+                      "): a checkpoint copied from another run directory is not continued, even "
+                      "with --force; put this run's own checkpoint back, or start the run again "
+                      "with --overwrite");
+  stamp.run_id = !dir_stamp.run_id.empty()  ? dir_stamp.run_id
+                 : !ck_stamp.run_id.empty() ? ck_stamp.run_id
+                                            : new_run_id();
+  restamp();
+  // an input file whose content changed is a changed key (rod.moduli_file, rod.intrinsic_file)
+  const std::string inputs_diff = input_differences(ck_stamp, stamp);
+  std::string diff = config::config_differences(ck.meta.config_toml, user, cp.string());
+  if (!inputs_diff.empty()) diff += (diff.empty() ? "" : "; ") + inputs_diff;
   config_changed = !diff.empty();
   // a later t_end alone extends the run: the continuation is the uninterrupted longer run
-  extension =
-      config_changed && config::only_end_time_extended(ck.meta.config_toml, user, cp.string());
+  extension = config_changed && inputs_diff.empty() &&
+              config::only_end_time_extended(ck.meta.config_toml, user, cp.string());
   if (extension) say("ibrod: extending the run in " + dir.root().string() + " (" + diff + ")");
+  extended_from_end = extension && ck.meta.stop_reason == to_string(StopReason::end_time);
   if (config_changed && !opt.force && !extension)
     throw ConfigError("resume: the configuration differs from the one " + cp.string() +
                       " was written with (" + diff +

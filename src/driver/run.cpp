@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include <omp.h>
 #include <nlohmann/json.hpp>
 
 #include "core/error.hpp"
@@ -19,6 +20,7 @@
 #include "io/csv.hpp"
 #include "io/npy.hpp"
 #include "io/rod_shape.hpp"
+#include "rod/rod_set.hpp"
 #include "sim/rod_problem.hpp"
 #include "sim/stability.hpp"
 
@@ -119,6 +121,26 @@ void Run::State::build_simulation() {
 }
 
 void Run::State::open_files() {
+  // extending an implicit run: its last step was shortened to land on the old t_end, which the
+  // longer run steps over unless the old t_end is a multiple of an interval in simulated time
+  // (where the longer run lands too; docs/large_dt.md)
+  if (extension && extended_from_end && sim->implicit()) {
+    const sim::OutputSchedule& out = sim->params().output;
+    bool lands = false;
+    for (double every : {out.rows_every, out.frames_every, out.checkpoints_every})
+      if (every > 0) {
+        const double k = std::round(sim->time() / every);
+        lands = lands || std::abs(sim->time() - k * every) <= 1e-9 * every;
+      }
+    if (!lands)
+      say("ibrod: warning: this extension of an implicit run is not bit for bit the uninterrupted "
+          "longer run: the run's last step was shortened to land on its old end time, " +
+          format_g(sim->time() / 1e-6) +
+          " us, which is no multiple of an output interval in simulated time (the longer run "
+          "steps over it); it agrees to the scheme's accuracy. For bitwise extensions schedule "
+          "the rows in simulated time (output.every_us) and end on their multiples "
+          "(docs/large_dt.md)");
+  }
   on_disk([&] {
     // extending a run that stopped at its end time: its last row and frame were written because
     // it stopped, not by the schedule; the uninterrupted longer run has them only if on schedule
@@ -214,6 +236,7 @@ void Run::State::write_checkpoint(StopReason reason) {
   if (!writes()) return;
   const auto u = sim->stepper().whole_velocity(gathered);
   on_root([&] {
+    files->check_directory(meta.step);
     io::write_checkpoint(dir.checkpoint(), meta, sim->rod(), sim->params().stepper.grid.n, u);
   });
 }
@@ -234,6 +257,7 @@ void Run::State::finish(const sim::Observables& o, const std::string& stop_reaso
   std::array<const double*, 3> u{};
   if (npy) u = sim->stepper().whole_velocity(gathered);
   on_disk([&] {
+    files->check_directory(r.steps);
     if (error.empty())
       io::write_file_atomic(dir.final_state(), io::final_state_csv(sim->rod(), sim->rod_ranges()));
     if (npy) io::write_velocity_npy(dir.velocity(), c.grid_n, u[0], u[1], u[2]);
@@ -351,6 +375,10 @@ void Run::State::check_link(const sim::Observables& o) {
 // The time loop: step, check, and write what the Simulation's schedule asks for.
 RunResult Run::State::loop(const std::function<int()>& pending, std::int64_t max_steps) {
   sim::Simulation& s = *sim;
+  // the step's OpenMP loops on the run's thread count in the thread that runs them: OpenMP keeps
+  // the count per thread, and the Python module may advance a run from a worker thread (where
+  // the default count would sum the per-thread pair-force buffers in another order)
+  omp_set_num_threads(s.stepper().fluid_threads());
   loop_start = Clock::now();
   start_step = s.step_count();
   result.signal = 0;
@@ -480,38 +508,68 @@ RunResult Run::State::loop(const std::function<int()>& pending, std::int64_t max
   return result;
 }
 
+InitialShapes read_initial_shapes(const config::Config& c) {
+  InitialShapes out;
+  const auto read = [&](const config::Config& cr, const std::string& key, int rod) {
+    rod::RodState shape = io::read_rod_shape(cr.rod_initial_shape, key, rod);
+    if (const std::string bad =
+            sim::state_problem(shape, cr.rod_base_pairs, cr.rod_rise_A, cr.rod_closed);
+        !bad.empty())
+      throw ConfigError(key + " = '" + cr.rod_initial_shape + "': " + bad +
+                        " (rod.base_pairs = " + std::to_string(cr.rod_base_pairs) +
+                        ", rod.rise_A = " + format_g(cr.rod_rise_A) + " Å)");
+    return shape;
+  };
+  if (c.rods.empty()) {
+    if (!c.rod_initial_shape.empty()) out.one = read(c, "rod.initial_shape", -1);
+    return out;
+  }
+  // several rods: each [[rods]] table's own rod.initial_shape (rod r of a file of several rods)
+  bool any = false;
+  for (int r = 0; r < config::rod_count(c); ++r) {
+    const config::Config cr = config::rod_config(c, r);
+    out.per_rod.emplace_back();
+    if (cr.rod_initial_shape.empty()) continue;
+    out.per_rod.back() = read(cr, "rods." + std::to_string(r) + ".initial_shape", r);
+    any = true;
+  }
+  // the rods together: no two on top of each other, in the box or across its faces
+  if (config::rod_count(c) > 1) {
+    const sim::SimParams p = config::to_params(c);
+    rod::RodState whole = sim::initial_state(p);
+    if (any) {
+      const std::vector<rod::RodRange> ranges = rod::ranges_of(integrate::all_rods(p.stepper));
+      for (std::size_t r = 0; r < out.per_rod.size(); ++r) {
+        if (!out.per_rod[r]) continue;
+        for (int k = 0; k < ranges[r].n; ++k) {
+          whole.X[ranges[r].offset + k] = out.per_rod[r]->X[k];
+          whole.D[ranges[r].offset + k] = out.per_rod[r]->D[k];
+        }
+      }
+    }
+    if (const std::string bad =
+            sim::rods_state_problem(integrate::all_rods(p.stepper), whole, p.stepper.grid.L);
+        !bad.empty())
+      throw ConfigError("[[rods]]: the initial state: " + bad);
+  }
+  return out;
+}
+
 Run::Run(const config::Config& c, const RunOptions& opt) {
   config::validate(c);
   s_ = std::make_unique<State>(c, opt);
+  // the per-link files (rod.moduli_file, rod.intrinsic_file) read and checked before anything is
+  // written, as every key is
+  (void)config::to_params(c);
+  // a fresh run gets its id here; a resumed one keeps its own (Run::State::open_checkpoint)
+  if (!opt.resume) s_->stamp.run_id = new_run_id();
+  s_->stamp.inputs = input_checksums(c);
+  s_->restamp();
   // rod.initial_shape: read and checked before anything is written (a resumed run has its state)
-  // several rods: each [[rods]] table's own rod.initial_shape (rod r of a file of several rods)
-  if (!c.rods.empty() && !opt.resume) {
-    for (int r = 0; r < config::rod_count(c); ++r) {
-      const config::Config cr = config::rod_config(c, r);
-      s_->rod_shapes.emplace_back();
-      if (cr.rod_initial_shape.empty()) continue;
-      const std::string key = "rods." + std::to_string(r) + ".initial_shape";
-      rod::RodState shape = io::read_rod_shape(cr.rod_initial_shape, key, r);
-      if (const std::string bad =
-              sim::state_problem(shape, cr.rod_base_pairs, cr.rod_rise_A, cr.rod_closed);
-          !bad.empty())
-        throw ConfigError(key + " = '" + cr.rod_initial_shape + "': " + bad +
-                          " (rod.base_pairs = " + std::to_string(cr.rod_base_pairs) +
-                          ", rod.rise_A = " + format_g(cr.rod_rise_A) + " Å)");
-      s_->rod_shapes.back() = std::move(shape);
-    }
-  }
-  if (c.rods.empty() && !c.rod_initial_shape.empty() && !opt.resume) {
-    const std::string key = "rod.initial_shape";
-    rod::RodState shape = io::read_rod_shape(c.rod_initial_shape, key);
-    const std::string what = key + " = '" + c.rod_initial_shape + "'";
-    if (const std::string bad =
-            sim::state_problem(shape, c.rod_base_pairs, c.rod_rise_A, c.rod_closed);
-        !bad.empty())
-      throw ConfigError(what + ": " + bad +
-                        " (rod.base_pairs = " + std::to_string(c.rod_base_pairs) +
-                        ", rod.rise_A = " + format_g(c.rod_rise_A) + " Å)");
-    s_->initial_shape = std::move(shape);
+  if (!opt.resume) {
+    InitialShapes shapes = read_initial_shapes(c);
+    s_->initial_shape = std::move(shapes.one);
+    s_->rod_shapes = std::move(shapes.per_rod);
   }
 }
 
@@ -564,7 +622,7 @@ void Run::set_end_time(double t_end_us) {
   next.time_t_end_us = t_end_us;
   config::validate(next);
   st.user.time_t_end_us = st.c.time_t_end_us = t_end_us;
-  st.config_text = config::to_toml(st.user);
+  st.restamp();
   st.meta.config_toml = st.config_text;
   if (st.sim) st.sim->set_t_end(t_end_us * 1e-6);
   st.on_disk([&] { io::write_file_atomic(st.dir.config(), st.config_text); });

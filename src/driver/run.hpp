@@ -19,6 +19,7 @@
 #include <cstdio>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -108,6 +109,17 @@ class Run {
   struct State;
   std::unique_ptr<State> s_;
 };
+
+/// The initial shapes of a fresh run (rod.initial_shape; with [[rods]] each table's own), read and
+/// checked before anything is written: each shape fits its rod (sim::state_problem), and with
+/// several rods the rods' start together (the built-in shapes where no file is given) has no two
+/// rods overlapping, across the periodic box's faces too. Throws ConfigError naming the key.
+/// `ibrod check` calls it as `ibrod run` does.
+struct InitialShapes {
+  std::optional<rod::RodState> one;                   ///< one rod: rod.initial_shape, if given
+  std::vector<std::optional<rod::RodState>> per_rod;  ///< [[rods]]: each table's, or none
+};
+InitialShapes read_initial_shapes(const config::Config& c);
 
 /// Run(c, opt).execute().
 RunResult run(const config::Config& c, const RunOptions& opt);

@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <vector>
 
 #include "io/observables_json.hpp"
 
@@ -40,8 +41,17 @@ void prepare_output_dir(const io::RunDir& run_dir, bool overwrite, std::optional
                       "continue a stopped run with --resume " +
                       dir.string());
   if (overwrite) {
-    // stale frames or a stale checkpoint of an earlier run must not mix with this one
+    // stale frames or a stale checkpoint of an earlier run must not mix with this one; only what
+    // a run writes is removed (a file of the user's, in DIR or in vtk/, is kept)
     for (const fs::path& f : run_dir.run_files()) fs::remove_all(f, ec);
+    const fs::path vtk = dir / io::RunDir::kVtkDir;
+    if (fs::is_directory(fs::symlink_status(vtk, ec))) {
+      std::vector<fs::path> frames;
+      for (const auto& e : fs::directory_iterator(vtk, ec))
+        if (io::RunDir::is_frame_file(e.path().filename().string())) frames.push_back(e.path());
+      for (const fs::path& f : frames) fs::remove(f, ec);
+      fs::remove(vtk, ec);  // only if now empty
+    }
   }
 }
 

@@ -1,6 +1,8 @@
 #pragma once
 // The files of a run directory that grow while it runs — timeseries.csv, trajectory.h5, rod.pvd
 // (+ fluid.pvd) — and the ones written at its end (summary.json); driver::Run's writers.
+#include <sys/stat.h>
+
 #include <cerrno>
 #include <cstdint>
 #include <cstdio>
@@ -68,6 +70,18 @@ class RunFiles {
       if (frames_on_)
         h5_ = io::H5mdWriter::create(dir.trajectory(), n, c.grid_box_A, config_text, species);
     } else {
+      // a file of the run that is gone (deleted by hand) starts again at the checkpoint: said,
+      // since every row or frame before it is lost
+      const auto missing = [&](const std::filesystem::path& f, const std::string& what) {
+        std::error_code ec;
+        if (std::filesystem::exists(f, ec)) return;
+        progress.message("ibrod: warning: " + f.string() +
+                         " is missing (deleted?); it starts again at the checkpoint (step " +
+                         std::to_string(resume_step) + "), so the " + what + " before it are lost");
+      };
+      missing(ts, "time-series rows");
+      if (several) missing(dir.rods(), "rows");
+      if (frames_on_) missing(dir.trajectory(), "frames");
       io::write_file_atomic(
           ts, io::timeseries_up_to(try_read_text_file(ts).value_or(""), io::timeseries_header(),
                                    resume_step, ts.string()));
@@ -80,6 +94,12 @@ class RunFiles {
         reopen_trajectory(dir.trajectory(), n, c.grid_box_A, frame_step, config_text, progress);
       if (frames_on_) rod_pvd_.resume(frame_step);
       if (frames_on_ && vti_) fluid_pvd_.resume(frame_step);
+    }
+    // the directory as it is now: one deleted or moved under the running process is noticed
+    struct stat st {};
+    if (::stat(dir.root().c_str(), &st) == 0) {
+      dev_ = st.st_dev;
+      ino_ = st.st_ino;
     }
     ts_ = std::fopen(ts.c_str(), "a");
     if (!ts_)
@@ -118,7 +138,23 @@ class RunFiles {
                                        "its first checkpoint)"));
   }
 
+  /// Throws RunError if the run directory is no longer where it was (deleted, moved, replaced):
+  /// every write after that would go into deleted files or a stranger's directory, so the run
+  /// stops, saying where its files may be (a moved directory continues with --resume where it
+  /// now is; a deleted one has nothing left to continue).
+  void check_directory(std::int64_t step) const {
+    struct stat st {};
+    if (::stat(dir_.root().c_str(), &st) == 0 && st.st_dev == dev_ && st.st_ino == ino_) return;
+    throw RunError("output: the run directory " + dir_.root().string() +
+                   " was deleted or moved while the run was writing it (noticed at step " +
+                   std::to_string(step) +
+                   "); the run stops here rather than write where nobody would find it. If it "
+                   "was moved, continue it where it is now with --resume NEWDIR; if it was "
+                   "deleted, there is no checkpoint left to --resume from: start the run again");
+  }
+
   void row(const sim::Observables& o) {
+    check_directory(o.step);
     // flushed row by row: a killed run loses nothing already computed
     if (std::fprintf(ts_, "%s\n", io::timeseries_row(o).c_str()) < 0 || std::fflush(ts_) != 0)
       throw RunError("output: cannot write " + dir_.timeseries().string() + ": " +
@@ -133,6 +169,7 @@ class RunFiles {
   // u: the whole fluid velocity (Stepper::whole_velocity), read only with output.fluid_vti
   void frame(const sim::Simulation& sim, std::array<const double*, 3> u) {
     if (!frames_on_) return;
+    check_directory(sim.step_count());
     const double t_us = sim.time() / 1e-6;
     h5_->write_frame(sim.step_count(), t_us, sim.rod());
     rod_pvd_.add(sim.step_count(), t_us,
@@ -149,6 +186,8 @@ class RunFiles {
   std::vector<rod::RodRange> ranges_;
   std::vector<double> rod_ds_;  // each rod's Δs, Å
   bool vti_, frames_on_;
+  dev_t dev_ = 0;  // the run directory's device and inode when the run opened it
+  ino_t ino_ = 0;
   std::FILE* ts_ = nullptr;
   std::FILE* rods_ = nullptr;  // rods.csv (several rods)
   std::unique_ptr<io::H5mdWriter> h5_;

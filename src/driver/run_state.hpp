@@ -16,6 +16,7 @@
 #include "driver/progress.hpp"
 #include "driver/run.hpp"
 #include "driver/run_files.hpp"
+#include "driver/run_stamp.hpp"
 #include "driver/signals.hpp"
 #include "io/checkpoint.hpp"
 #include "io/run_dir.hpp"
@@ -40,7 +41,8 @@ struct Run::State {
   config::Config c;     // as run (threads resolved on resume)
   RunOptions opt;
   io::RunDir dir;
-  std::string config_text;
+  std::string config_text;  // config.toml: to_toml(user) and the stamp (restamp())
+  RunStamp stamp;           // the run's id and its input files' checksums
   Clock::time_point t0 = Clock::now();
   bool distributed = false;
   Progress progress;
@@ -49,6 +51,7 @@ struct Run::State {
   std::optional<io::Checkpoint> checkpoint;  // the one to continue from, until it is applied
   bool config_changed = false;
   bool extension = false;  // --resume with a later time.t_end_us alone
+  bool extended_from_end = false;  // ... of a run that had stopped at its end time
   // a run that stopped but was killed before its final files were all written: --resume only
   // writes them (the reason it stopped, from the checkpoint)
   bool complete_only = false;
@@ -78,6 +81,8 @@ struct Run::State {
         progress(o.rank == 0 ? o.log : nullptr, o.tty) {}
 
   void say(const std::string& s) { progress.message(s); }
+  /// config_text from user and stamp (after either changes)
+  void restamp() { config_text = config::to_toml(user) + stamp_text(stamp); }
   void on_root(const std::function<void()>& f) { mpi::on_root(opt.rank, opt.ranks, f); }
   /// Whether the run writes its directory (RunOptions::write_files).
   bool writes() const { return opt.write_files; }

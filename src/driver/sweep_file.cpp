@@ -55,7 +55,24 @@ void set_path(toml::table& tree, const std::string& key, const toml::node& v,
               const std::string& where) {
   const auto parts = split_key(key);
   toml::table* t = &tree;
-  for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
+  std::size_t first = 0;
+  // rods.K.key: key of [[rods]] table K (K = the number of tables appends one), as --set
+  if (parts.size() == 3 && parts[0] == "rods") {
+    std::size_t r = 0;
+    const auto [end, ec] = std::from_chars(parts[1].data(), parts[1].data() + parts[1].size(), r);
+    if (!tree.contains("rods")) tree.insert("rods", toml::array{});
+    toml::array* a = tree["rods"].as_array();
+    if (ec != std::errc() || end != parts[1].data() + parts[1].size() || !a ||
+        (!a->empty() && !a->is_array_of_tables()) || r > a->size())
+      throw ConfigError(
+          where + ": '" + key + "': a [[rods]] key is rods.K.key with K a table number from 0 to " +
+          std::to_string(a && a->is_array_of_tables() ? a->size() : 0) + " (" +
+          std::to_string(a && a->is_array_of_tables() ? a->size() : 0) + " appends a table)");
+    if (r == a->size()) a->push_back(toml::table{});
+    t = a->get(r)->as_table();
+    first = 2;
+  }
+  for (std::size_t i = first; i + 1 < parts.size(); ++i) {
     if (!t->contains(parts[i])) t->insert(parts[i], toml::table{});
     toml::table* next = (*t)[parts[i]].as_table();
     if (!next)
@@ -207,6 +224,10 @@ Sweep parse_sweep(const std::string& text, const std::string& source, const fs::
       (key == "sweep" ? sweep_table : names) = t;
       continue;
     }
+    if (key == "rods" && v.is_array()) {  // [[rods]] tables: replace the base's (as in a config)
+      copy_into(tree, key, v);
+      continue;
+    }
     if (const toml::table* t = v.as_table()) {
       toml::table overlay;
       overlay.insert(key, *t);
@@ -215,7 +236,8 @@ Sweep parse_sweep(const std::string& text, const std::string& source, const fs::
     }
     throw ConfigError(
         where + ": unknown top-level key '" + key +
-        "' (a sweep file has base, output_dir, [names], [sweep] and config sections)");
+        "' (a sweep file has base, output_dir, [names], [sweep], config sections and [[rods]] "
+        "tables)");
   }
   if (!sweep_table || sweep_table->empty())
     throw ConfigError(where + ": no [sweep] table: expected [sweep] with key = [values…]");

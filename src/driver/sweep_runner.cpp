@@ -295,6 +295,21 @@ SweepReport run_sweep(const Sweep& sw, const SweepOptions& opt) {
     } else if (rep.signal && (code == 128 + SIGINT || code == 128 + SIGTERM ||
                               killed_by == SIGINT || killed_by == SIGTERM)) {
       say(tag + r.pt->name + ": stopped, checkpoint kept");
+    } else if (const PointState now = code == 2 ? point_state(dir) : PointState::fresh;
+               code == 2 && (now == PointState::running ||
+                             last_line(log).find("is being written by another ibrod process") !=
+                                 std::string::npos)) {
+      // another process (a second sweep on the same directory) started the point between the
+      // look at it and this start: the lock refused this run; the point is healthy
+      ++rep.running;
+      const auto holder = dir_lock_holder(dir);
+      say(tag + r.pt->name + ": running in another process" +
+          (holder && *holder > 0 ? " (PID " + std::to_string(*holder) + ")" : std::string()) +
+          "; not started again");
+    } else if (code == 2 && now == PointState::finished) {
+      // ... or ran it to its end in that time
+      ++rep.skipped;
+      say(tag + r.pt->name + ": finished by another process meanwhile");
     } else {
       const std::string why = killed_by ? std::string("killed by signal ") + strsignal(killed_by)
                                         : "exit status " + std::to_string(code);

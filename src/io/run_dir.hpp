@@ -47,11 +47,28 @@ class RunDir {
   static constexpr const char* kFluidSeries = "fluid";
   static constexpr const char* kVtkDir = "vtk";
 
-  /// Every file and folder a run writes (what --overwrite removes before a new run).
+  /// Every file a run writes at the top of the directory (what --overwrite removes before a new
+  /// run, with the frames of vtk/ that is_frame_file names; nothing else: a file of the user's
+  /// in the directory or in vtk/ is kept).
   std::vector<std::filesystem::path> run_files() const {
-    return {config(),        timeseries(), trajectory(),  root_ / "rod.pvd", root_ / "fluid.pvd",
-            checkpoint(),    wisdom(),     final_state(), summary(),         velocity(),
-            root_ / kVtkDir, rods()};
+    return {config(),     timeseries(), trajectory(),  root_ / "rod.pvd", root_ / "fluid.pvd",
+            checkpoint(), wisdom(),     final_state(), summary(),         velocity(),
+            rods()};
+  }
+  /// Whether `name` (a file name in vtk/) is a frame a run writes: rod_<step>.vtp or
+  /// fluid_<step>.vti (or such a file's ".tmp" of a write cut off).
+  static bool is_frame_file(std::string name) {
+    if (name.size() > 4 && name.compare(name.size() - 4, 4, ".tmp") == 0)
+      name.resize(name.size() - 4);
+    const auto is_frame = [&](const std::string& prefix, const std::string& ext) {
+      if (name.size() <= prefix.size() + ext.size() + 1 || name.rfind(prefix + "_", 0) != 0 ||
+          name.compare(name.size() - ext.size(), ext.size(), ext) != 0)
+        return false;
+      for (std::size_t i = prefix.size() + 1; i < name.size() - ext.size(); ++i)
+        if (name[i] < '0' || name[i] > '9') return false;
+      return true;
+    };
+    return is_frame(kRodSeries, ".vtp") || is_frame(kFluidSeries, ".vti");
   }
 
  private:

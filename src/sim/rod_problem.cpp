@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "core/units.hpp"
 #include "rod/rod_set.hpp"
 
 namespace ibrod::sim {
@@ -70,6 +71,24 @@ std::string state_problem(const rod::RodState& s, int n, double ds, bool closed)
                     det);
       return buf;
     }
+  // D³ along the rod: an orthonormal triad with its rows and columns swapped passes the checks
+  // above, and the run then blows up at its first step
+  for (int k = 0; k < n; ++k) {
+    const int prev = k > 0 ? k - 1 : closed ? n - 1 : 0;
+    const int next = k + 1 < n ? k + 1 : closed ? 0 : n - 1;
+    const Vec3 t = s.X[next] - s.X[prev];  // central; one-sided at an open rod's ends
+    const double c = t.dot(s.D[k].col(2)) / t.norm();
+    if (!(c >= kMinTangentCosine)) {
+      char buf[320];
+      std::snprintf(buf, sizeof buf,
+                    "the triad of point %d has D³ %.0f° off the rod's tangent (at most %.0f° "
+                    "allowed: D³ points along the rod, from point k toward point k + 1; are D's "
+                    "rows and columns swapped?)",
+                    k, std::acos(std::clamp(c, -1.0, 1.0)) * 180 / M_PI,
+                    std::acos(kMinTangentCosine) * 180 / M_PI);
+      return buf;
+    }
+  }
   return {};
 }
 
@@ -102,7 +121,8 @@ std::string rods_problem(std::span<const rod::RodParams> rods, const rod::RodSta
   return {};
 }
 
-std::string rods_state_problem(std::span<const rod::RodParams> rods, const rod::RodState& s) {
+std::string rods_state_problem(std::span<const rod::RodParams> rods, const rod::RodState& s,
+                               double box) {
   if (rods.size() == 1) return state_problem(s, rods[0].n, rods[0].ds, rods[0].closed);
   const int n = total_points(rods);
   if (s.size() != n || int(s.D.size()) != n)
@@ -121,14 +141,18 @@ std::string rods_state_problem(std::span<const rod::RodParams> rods, const rod::
       const double min_d = 0.5 * std::min(rods[a].ds, rods[b].ds);
       for (int i = 0; i < ranges[a].n; ++i)
         for (int j = 0; j < ranges[b].n; ++j) {
-          const double d = (s.X[ranges[a].offset + i] - s.X[ranges[b].offset + j]).norm();
+          Vec3 v = s.X[ranges[a].offset + i] - s.X[ranges[b].offset + j];
+          // the box is periodic: a rod on another's periodic image lies on it in the fluid
+          if (box > 0) v -= box * (v / box).array().round().matrix();
+          const double d = v.norm();
           if (!(d >= min_d)) {
-            char buf[256];
+            char buf[400];
             std::snprintf(buf, sizeof buf,
                           "rods %zu and %zu overlap: point %d of rod %zu and point %d of rod %zu "
-                          "are %.3g Å apart (at least half a rise, %.3g Å, needed; place the rods "
-                          "apart with rod.offset_A)",
-                          a, b, i, a, j, b, d, min_d);
+                          "are %.3g Å apart%s (at least half a rise, %.3g Å, needed; place the "
+                          "rods apart with rod.offset_A)",
+                          a, b, i, a, j, b, d / units::angstrom,
+                          box > 0 ? " in the periodic box" : "", min_d / units::angstrom);
             return buf;
           }
         }

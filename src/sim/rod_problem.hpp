@@ -25,7 +25,8 @@ double spacing_tolerance(const rod::RodParams& rod, double thermal_kT);
 
 /// Empty if `s` may be a rod of n points Δs = ds apart (an initial shape, a state set from
 /// Python); otherwise what is wrong: a count of positions or triads other than n, what
-/// rod_problem finds, or a left-handed triad (det D < 0: D³ must be D¹ × D²).
+/// rod_problem finds, a left-handed triad (det D < 0: D³ must be D¹ × D²), or a D³ more than
+/// 60° off the tangent X[k+1] − X[k−1] (one-sided at an open rod's ends).
 std::string state_problem(const rod::RodState& s, int n, double ds, bool closed = true);
 
 /// The same for the rods of a state of one or several rods laid end to end (rod::RodRange): each
@@ -36,6 +37,13 @@ std::string state_problem(const rod::RodState& s, int n, double ds, bool closed 
 /// too. O(n), no allocation: the blow-up guard after every step.
 std::string rods_problem(std::span<const rod::RodParams> rods, const rod::RodState& s,
                          std::span<const double> tolerances);
-std::string rods_state_problem(std::span<const rod::RodParams> rods, const rod::RodState& s);
+/// box > 0: the edge of the periodic box (internal units); two rods overlap if any of their points
+/// are closer than half a rise across the box's faces too (the nearest periodic image).
+std::string rods_state_problem(std::span<const rod::RodParams> rods, const rod::RodState& s,
+                               double box = 0);
+
+/// The smallest cosine between a triad's D³ and the rod's tangent that state_problem accepts
+/// (60°: far beyond any shear a run reaches, far below a triad with rows and columns swapped).
+inline constexpr double kMinTangentCosine = 0.5;
 
 }  // namespace ibrod::sim

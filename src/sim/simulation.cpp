@@ -109,14 +109,14 @@ rod::RodState shape_of(const rod::RodParams& rp, const rod::CircleParams& c, con
   return s;
 }
 
-// The initial state: each rod's shape, laid end to end.
+}  // namespace
+
 rod::RodState initial_state(const SimParams& p) {
   rod::RodState s = shape_of(p.stepper.rod, p.circle, p.rotation);
   for (std::size_t r = 0; r < p.stepper.more_rods.size(); ++r)
     rod::append(s, shape_of(p.stepper.more_rods[r], p.more_circles[r], p.more_rotations[r]));
   return s;
 }
-}  // namespace
 
 Simulation::Simulation(const SimParams& p)
     : p_(checked(p)),
@@ -151,12 +151,14 @@ void Simulation::set_t_end(double t_end) {
   p_.t_end = t_end;
 }
 
-std::string Simulation::start_problem() const { return rods_state_problem(rods_, rod_); }
+std::string Simulation::start_problem() const {
+  return rods_state_problem(rods_, rod_, p_.stepper.grid.L);
+}
 
 std::string Simulation::state_check() const { return rods_problem(rods_, rod_, tolerances_); }
 
 void Simulation::set_rod_state(rod::RodState s, const std::string& what) {
-  if (const std::string bad = rods_state_problem(rods_, s); !bad.empty())
+  if (const std::string bad = rods_state_problem(rods_, s, p_.stepper.grid.L); !bad.empty())
     throw std::invalid_argument(what + ": " + bad);
   rod_ = std::move(s);
   if (implicit_) implicit_->refresh();

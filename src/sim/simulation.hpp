@@ -98,6 +98,10 @@ StopReason stop_reason_from(const std::string& name);
 /// k steps; half a step of tolerance).
 std::int64_t steps_to_reach(double t_end, double dt);
 
+/// The built-in initial state of p (each rod's twisted circle or straight rod, placed, laid end to
+/// end): the state a Simulation of p starts from, without building one (no fluid).
+rod::RodState initial_state(const SimParams& p);
+
 class Simulation {
  public:
   /// Builds the initial state (the twisted circle of p.circle, or each rod's shape placed in

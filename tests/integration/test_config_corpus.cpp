@@ -167,6 +167,8 @@ const std::vector<Case> kHandWritten = {
     {"[rod]\nperturbation_random = { modes = -1 }\n", "rod.perturbation_random.modes"},
     {"[rod]\nperturbation_random = { amplitude = 1e308 }\n", "rod.perturbation_random.amplitude"},
     {"[rod]\nperturbation_random = { seed = -1 }\n", "rod.perturbation_random.seed"},
+    // issue 26 T3-18: 100 000 [[rods]] tables took minutes (quadratic); refused at once
+    {"[rod]\nbase_pairs = 8\nexcess_link = 0\n" + repeat("[[rods]]\n", 100000), "at most 1000"},
 };
 
 // Every scalar key with values none of them accepts: huge, non-finite, and of the wrong type.
@@ -313,6 +315,14 @@ TEST(ConfigCorpus, EveryMalformedInputExitsWithAMessageNamingTheProblem) {
       {{"--set", "rod.intrinsic_twist_per_A=1e308"}, "rod.intrinsic_twist_per_A"},
       {{"--set", "grid.box_A=1e308"}, "grid.box_A"},
       {{"--set", "electrostatics.charge_e=1e308"}, "electrostatics.charge_e"},
+      // issue 26 T3-1, T3-2: per-link files that are no regular file, refused before they are
+      // opened (a FIFO blocked for ever, /dev/zero filled the memory, a directory read as empty)
+      {{"--set", "rod.moduli_file=\"" + fifo.string() + "\""}, "not a regular file"},
+      {{"--set", "rod.intrinsic_file=\"" + fifo.string() + "\""}, "not a regular file"},
+      {{"--set", "rod.moduli_file=\"/dev/zero\""}, "rod.moduli_file", gib},
+      {{"--set", "rod.intrinsic_file=\"/dev/zero\""}, "rod.intrinsic_file", gib},
+      {{"--set", "rod.moduli_file=\"" + dir.string() + "\""}, "it is a directory"},
+      {{"--set", "rod.intrinsic_file=\"" + dir.string() + "\""}, "it is a directory"},
       // item 7: more memory than this process may allocate, refused before any is
       {{"--set", "grid.n=1024"}, "grid.n = 1024", 4 * gib},
       {{"--set", "grid.n=512"}, "grid.n = 512", 2 * gib},

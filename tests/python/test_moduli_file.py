@@ -91,4 +91,4 @@ def test_missing_file_is_refused(tmp_path):
     cfg["rod.moduli_file"] = str(tmp_path / "none.csv")
     with pytest.raises(ibrod.ConfigError) as e:
         ibrod.Simulation(cfg)
-    assert "rod.moduli_file" in str(e.value) and "cannot open" in str(e.value)
+    assert "rod.moduli_file" in str(e.value) and "it does not exist" in str(e.value)

@@ -66,7 +66,7 @@ TEST(IntrinsicFileKey, BadFilesAreRefusedNamingKeyAndProblem) {
   const std::string missing = with_file("/nonexistent/omega.csv", 50).rod_intrinsic_file;
   EXPECT_THAT(params_error(with_file(missing, 50)),
               AllOf(HasSubstr("rod.intrinsic_file"), HasSubstr("/nonexistent/omega.csv"),
-                    HasSubstr("cannot open")));
+                    HasSubstr("it does not exist")));
   std::string rows;
   for (int k = 0; k < 49; ++k) rows += "0,0,0.04\n";
   const std::string short_file = write_file("short.csv", rows);

@@ -98,7 +98,7 @@ TEST(ModuliFileKey, RowsOfTheScalarKeysGiveTheScalarModuliExactly) {
 TEST(ModuliFileKey, BadFilesAreRefusedNamingKeyFileAndLine) {
   EXPECT_THAT(params_error(with_file("/nonexistent/moduli.csv", 50)),
               AllOf(HasSubstr("rod.moduli_file"), HasSubstr("/nonexistent/moduli.csv"),
-                    HasSubstr("cannot open")));
+                    HasSubstr("it does not exist")));
   std::string rows;
   for (int k = 0; k < 49; ++k) rows += kDefaultRow;
   std::vector<std::string> files;

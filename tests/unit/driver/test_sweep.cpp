@@ -7,6 +7,7 @@
 #include <fstream>
 #include <set>
 
+#include "config/config.hpp"
 #include "core/error.hpp"
 #include "driver/sweep_runner.hpp"
 
@@ -119,6 +120,30 @@ TEST(Sweep, BadSweepFilesAreRejectedNamingTheKey) {
   // a bad key in the base sections
   EXPECT_THAT(error_of(t + "[steric]\nfoo = 1\n[sweep]\nrod.excess_link = [1]\n"),
               HasSubstr("unknown key 'steric.foo'"));
+}
+
+// T3-7 (issue 26): docs/config.md says a sweep can vary rods.K.key like any key; it could not
+// ("'rods' is a value"). K from 0, K = the number of tables appends one, as --set.
+TEST(Sweep, AKeyOfARodsTableIsSweptLikeAnyKey) {
+  const std::string rods = "[[rods]]\nexcess_link = 0\n[[rods]]\noffset_A = [0, 0, 60]\n";
+  const auto sw = parse(std::string(kTiny) + rods +
+                        "[sweep]\n\"rods.1.excess_link\" = [0, 1]\n\"rods.2.offset_A\" = "
+                        "[[0, 0, -60]]\n");
+  ASSERT_EQ(sw.points.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    const config::Config& c = sw.points[i].config;
+    ASSERT_EQ(config::rod_count(c), 3);
+    EXPECT_EQ(config::rod_config(c, 0).rod_excess_link, 0);
+    EXPECT_EQ(config::rod_config(c, 1).rod_excess_link, int(i));
+    EXPECT_EQ(config::rod_config(c, 1).rod_offset_A[2], 60.0);
+    EXPECT_EQ(config::rod_config(c, 2).rod_offset_A[2], -60.0);
+  }
+  EXPECT_EQ(sw.points[1].name, "excess_link=1_offset_A=0,0,-60");
+  // a table number past the end, or a bad value, names the key
+  EXPECT_THAT(error_of(std::string(kTiny) + rods + "[sweep]\n\"rods.5.excess_link\" = [1]\n"),
+              HasSubstr("rods.5.excess_link"));
+  EXPECT_THAT(error_of(std::string(kTiny) + rods + "[sweep]\n\"rods.1.excess_link\" = [1.5]\n"),
+              HasSubstr("rods.1.excess_link"));
 }
 
 TEST(Sweep, PointStatesFollowTheRunFiles) {

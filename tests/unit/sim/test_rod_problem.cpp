@@ -32,13 +32,28 @@ TEST(RodProblem, NamesThePointAndTheQuantity) {
 }
 
 // sim::state_problem: what an initial shape or a state set from Python must be, besides sane.
-TEST(RodProblem, AStateMustHaveTheRodsPointsAndRightHandedTriads) {
-  const double ds = 3.4, r = ds / (2 * std::sin(M_PI / 10));
+namespace {
+// A ring of 10 points Δs apart in the z = 0 plane with triads D¹ = z, D² = outward, D³ = D¹ × D²
+// along the tangent (turned by `twist` about it), centred at `centre`.
+rod::RodState ring(double ds, double twist = 0, const Vec3& centre = Vec3::Zero()) {
+  const double r = ds / (2 * std::sin(M_PI / 10));
   rod::RodState s;
   for (int k = 0; k < 10; ++k) {
-    s.X.push_back(Vec3(r * std::cos(2 * M_PI * k / 10), r * std::sin(2 * M_PI * k / 10), 0));
-    s.D.push_back(rotation(Vec3(0, 0, 0.1 * k)));
+    const double th = 2 * M_PI * k / 10;
+    s.X.push_back(centre + Vec3(r * std::cos(th), r * std::sin(th), 0));
+    Mat3 D;
+    D.col(0) = Vec3(0, 0, 1);
+    D.col(1) = Vec3(std::cos(th), std::sin(th), 0);
+    D.col(2) = D.col(0).cross(D.col(1));
+    s.D.push_back(rotation(twist * k * D.col(2)) * D);
   }
+  return s;
+}
+}  // namespace
+
+TEST(RodProblem, AStateMustHaveTheRodsPointsAndRightHandedTriads) {
+  const double ds = 3.4;
+  const rod::RodState s = ring(ds, 0.1);
   EXPECT_EQ(sim::state_problem(s, 10, ds), "");
   EXPECT_THAT(sim::state_problem(s, 12, ds), HasSubstr("10 positions and 10 triads"));
   EXPECT_THAT(sim::state_problem(s, 12, ds), HasSubstr("12 points (rod.base_pairs)"));
@@ -71,4 +86,40 @@ TEST(SpacingTolerance, FollowsTheSoftestLinkInUse) {
   EXPECT_EQ(sim::spacing_tolerance(p, 1e3 * kT), base);
   p.b_k[3].x() /= 100;
   EXPECT_NEAR(sim::spacing_tolerance(p, 1e3 * kT), 10 * base, 1e-9 * base);
+}
+
+// T3-11 (issue 26): an orthonormal, right-handed triad whose rows and columns were swapped passed
+// every check above, and the run blew up at its first step blaming Δt. D³ must lie along the rod.
+TEST(RodProblem, AStateWithD3OffTheTangentIsRefusedNamingThePoint) {
+  const double ds = 3.4;
+  const rod::RodState s = ring(ds, 0.3);
+  ASSERT_EQ(sim::state_problem(s, 10, ds), "");
+  rod::RodState swapped = s;
+  for (Mat3& D : swapped.D) D.transposeInPlace();
+  EXPECT_EQ(sim::rod_problem(swapped, ds), "");  // orthonormal: the per-step check passes it
+  EXPECT_THAT(sim::state_problem(swapped, 10, ds), HasSubstr("off the rod's tangent"));
+  // a sheared triad within 60° is a state, not an error; past it one point is named
+  rod::RodState sheared = s;
+  sheared.D[4] = rotation(Vec3(0, 0, 1) * (50 * M_PI / 180)) * sheared.D[4];
+  EXPECT_EQ(sim::state_problem(sheared, 10, ds), "");
+  sheared.D[4] = rotation(Vec3(0, 0, 1) * (25 * M_PI / 180)) * sheared.D[4];
+  EXPECT_THAT(sim::state_problem(sheared, 10, ds), HasSubstr("point 4 has D³ 75° off"));
+}
+
+// T3-12 (issue 26): two rods placed on each other's periodic image ran through each other; the
+// start check sees the periodic box.
+TEST(RodProblem, TwoRodsOnEachOthersPeriodicImageOverlap) {
+  const double ds = 3.4, box = 200;
+  rod::RodParams p;
+  p.n = 10;
+  p.ds = ds;
+  const std::vector<rod::RodParams> rods{p, p};
+  rod::RodState both = ring(ds, 0, Vec3(100, 100, 100));
+  const rod::RodState image = ring(ds, 0, Vec3(100 + box, 100, 100));
+  both.X.insert(both.X.end(), image.X.begin(), image.X.end());
+  both.D.insert(both.D.end(), image.D.begin(), image.D.end());
+  EXPECT_EQ(sim::rods_state_problem(rods, both), "");  // unwrapped: 200 Å apart
+  EXPECT_THAT(sim::rods_state_problem(rods, both, box), HasSubstr("overlap"));
+  EXPECT_THAT(sim::rods_state_problem(rods, both, box), HasSubstr("in the periodic box"));
+  EXPECT_EQ(sim::rods_state_problem(rods, both, 2 * box), "");  // a larger box: apart
 }
