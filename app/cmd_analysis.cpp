@@ -108,7 +108,7 @@ void add_analysis_commands(CLI::App& app) {
       ->capture_default_str();
   analyze->add_flag(
       "--frames", a->opt.every_frame,
-      "also the shape of every frame of DIR/trajectory.h5 (summary.json shape_frames)");
+      "also the shape of every frame of DIR/trajectory.h5md (summary.json shape_frames)");
   analyze
       ->add_option("--contact-distance", a->opt.contact_distance_A,
                    "contact distance d_c in Å (default: D + 3 Debye lengths of config.toml)")
@@ -138,7 +138,7 @@ void add_analysis_commands(CLI::App& app) {
   render->add_option("dir", r->dir, "run directory (written by ibrod run)")->required();
   render
       ->add_option("--time", r->opt.times,
-                   "time in µs (nearest frame of DIR/trajectory.h5) or 'final'; repeatable or "
+                   "time in µs (nearest frame of DIR/trajectory.h5md) or 'final'; repeatable or "
                    "comma-separated (default: final)")
       ->delimiter(',');
   render
@@ -159,7 +159,7 @@ void add_analysis_commands(CLI::App& app) {
   render->add_flag("!--no-labels", r->opt.labels,
                    "no time, Wr, ΔLk, Cs and scale bar on the pictures");
   render->add_flag("--movie", r->opt.movie,
-                   "every frame of DIR/trajectory.h5 from the first view, at one scale, into "
+                   "every frame of DIR/trajectory.h5md from the first view, at one scale, into "
                    "DIR/render/movie_<view>/frame_NNNNN.png, as the animated PNG "
                    "DIR/render/rod_<view>.apng, and DIR/render/rod_<view>.mp4 with ffmpeg if "
                    "installed");

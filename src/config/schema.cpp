@@ -273,7 +273,7 @@ Key initial_shape_key() {
   k.name = "rod.initial_shape";
   k.help =
       "start from this shape instead of the twisted circle: a run's final_state.csv, or "
-      "\"trajectory.h5@FRAME\" (FRAME from 0, -1 the last); \"\": the circle";
+      "\"trajectory.h5md@FRAME\" (FRAME from 0, -1 the last); \"\": the circle";
   k.set = [](Config& c, const toml::node& n) {
     const auto v = n.value_exact<std::string>();
     if (!v) bad("rod.initial_shape", show(n), "a file name in quotes, or \"\" for the circle");
