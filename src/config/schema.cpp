@@ -28,7 +28,9 @@ using rod::RandomPerturbation;
 
 Config::Config()
     : electrostatics_cutoff_debye(interactions::kDefaultCutoffDebye),
-      steric_stiffness_kT_A2(interactions::kDefaultStericStiffness / units::kT(300.0)) {}
+      // 0.1 kT/Å² as written in config.toml, not interactions::kDefaultStericStiffness (41.419
+      // g s⁻², from kT(300 K) rounded to 414.19) converted back, which read 0.0999988652679525
+      steric_stiffness_kT_A2(0.1) {}
 
 namespace {
 
