@@ -40,19 +40,35 @@ std::string join(const std::vector<std::string>& v) {
   return s;
 }
 
-/// python/ibrod_report.py: $IBROD_REPORT_SCRIPT, else beside the source tree of a build directory
-/// (build/app/ibrod → python/), else installed beside the binary (../share/ibrod/).
+/// python/ibrod_report.py (with ibrod_plot.py and ibrod_study.py beside it), the first found of:
+///   $IBROD_REPORT_SCRIPT;
+///   installed beside the binary: <bindir>/<IBROD_SCRIPTS_FROM_BINDIR>/ (cmake --install: bin/ →
+///   share/ibrod/; pip install: ibrod/bin/ → ibrod/share/ibrod/);
+///   the source tree this binary was built from (IBROD_SOURCE_PYTHON_DIR: any build directory);
+///   ../../python/ from the binary (an in-tree build/app/ibrod moved with its source tree).
 std::filesystem::path report_script() {
   namespace fs = std::filesystem;
   if (const char* env = std::getenv("IBROD_REPORT_SCRIPT")) return env;
   std::error_code ec;
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec)
-    for (const fs::path& p : {exe.parent_path() / "../../python/ibrod_report.py",
-                              exe.parent_path() / "../share/ibrod/ibrod_report.py"})
-      if (fs::exists(p)) return fs::weakly_canonical(p);
-  throw ibrod::ConfigError(
-      "ibrod report: python/ibrod_report.py not found (set IBROD_REPORT_SCRIPT to its path)");
+  std::vector<fs::path> where;
+  if (!ec) where.push_back(exe.parent_path() / IBROD_SCRIPTS_FROM_BINDIR / "ibrod_report.py");
+  where.push_back(fs::path(IBROD_SOURCE_PYTHON_DIR) / "ibrod_report.py");
+  if (!ec) where.push_back(exe.parent_path() / "../../python/ibrod_report.py");
+  std::string looked;
+  for (const fs::path& p : where) {
+    if (fs::is_regular_file(p, ec)) return fs::weakly_canonical(p);
+    looked += (looked.empty() ? "" : ", ") + p.lexically_normal().string();
+  }
+  throw ibrod::ConfigError("ibrod report: python/ibrod_report.py not found (looked in " + looked +
+                           "; set IBROD_REPORT_SCRIPT to its path)");
+}
+
+/// The Python that runs the report: $IBROD_PYTHON (the pip-installed `ibrod` command sets it to
+/// its environment's interpreter), else Debian's /usr/bin/python3 (numpy, matplotlib).
+std::string report_python() {
+  const char* env = std::getenv("IBROD_PYTHON");
+  return env && *env ? env : "/usr/bin/python3";
 }
 
 }  // namespace
@@ -70,7 +86,8 @@ void add_analysis_commands(CLI::App& app) {
       const std::string script = report_script().string();
       std::error_code ec;
       const std::string self = std::filesystem::read_symlink("/proc/self/exe", ec).string();
-      std::vector<std::string> args{"/usr/bin/python3", script};
+      const std::string python = report_python();
+      std::vector<std::string> args{python, script};
       for (const auto& r : report->remaining()) args.push_back(r);
       if (!ec) args.insert(args.end(), {"--ibrod", self});
       std::vector<char*> argv;
@@ -78,8 +95,7 @@ void add_analysis_commands(CLI::App& app) {
       argv.push_back(nullptr);
       std::fflush(stdout);
       ::execv(argv[0], argv.data());
-      throw ibrod::RunError(std::string("ibrod report: cannot run /usr/bin/python3: ") +
-                            std::strerror(errno));
+      throw ibrod::RunError("ibrod report: cannot run " + python + ": " + std::strerror(errno));
     });
   });
 
