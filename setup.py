@@ -5,7 +5,7 @@
     ibrod/_core*.so                                     the compiled module
     ibrod/bin/ibrod                                     the command line (the `ibrod` console
                                                         command runs it: ibrod/_cli.py)
-    ibrod/share/ibrod/ibrod_{report,plot,study}.py      the scripts `ibrod report` runs (found
+    ibrod/share/ibrod/ibrod_{report,plot,study,html}.py the scripts `ibrod report` runs (found
                                                         beside the binary as after cmake --install)
 
 The CMake build directory is build/pip (kept, so a second install rebuilds only what changed), or
@@ -23,7 +23,7 @@ from setuptools import Distribution, setup
 from setuptools.command.build_py import build_py
 
 ROOT = os.path.dirname(os.path.abspath(__file__))
-SCRIPTS = ["ibrod_report.py", "ibrod_plot.py", "ibrod_study.py"]
+SCRIPTS = ["ibrod_report.py", "ibrod_plot.py", "ibrod_study.py", "ibrod_html.py"]
 
 
 def version():

@@ -57,7 +57,7 @@ class Install(unittest.TestCase):
         sh("cmake", "--install", BUILD, "--prefix", prefix)
         exe = os.path.join(prefix, "bin", "ibrod")
         share = os.path.join(prefix, "share", "ibrod")
-        for s in ("ibrod_report.py", "ibrod_plot.py", "ibrod_study.py"):
+        for s in ("ibrod_report.py", "ibrod_plot.py", "ibrod_study.py", "ibrod_html.py"):
             self.assertTrue(os.path.isfile(os.path.join(share, s)), s)
         with open(os.path.join(share, "ibrod_report.py"), "w") as f:
             f.write(STUB)
@@ -91,7 +91,7 @@ class Install(unittest.TestCase):
         # its report runs the script packed in the environment, with the environment's Python
         share = sh(py, "-c", "import ibrod, os; print(os.path.join(os.path.dirname("
                    "os.path.realpath(ibrod.__file__)), 'share', 'ibrod'))", env=env).strip()
-        self.assertTrue(os.path.isfile(os.path.join(share, "ibrod_study.py")))
+        self.assertTrue(os.path.isfile(os.path.join(share, "ibrod_html.py")))
         with open(os.path.join(share, "ibrod_report.py"), "w") as f:
             f.write("import sys; print('STUB', __file__, sys.executable)\n")
         out = sh(cmd, "report", env=env)
