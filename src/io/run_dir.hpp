@@ -62,9 +62,18 @@ class RunDir {
 
   /// Every file and folder a run writes (what --overwrite removes before a new run).
   std::vector<std::filesystem::path> run_files() const {
-    return {config(),      timeseries(),    root_ / kTrajectory, root_ / kLegacyTrajectory,
-            root_ / "rod.pvd", root_ / "fluid.pvd", checkpoint(), wisdom(),
-            final_state(), summary(),       velocity(),          root_ / kVtkDir,
+    return {config(),
+            timeseries(),
+            root_ / kTrajectory,
+            root_ / kLegacyTrajectory,
+            root_ / "rod.pvd",
+            root_ / "fluid.pvd",
+            checkpoint(),
+            wisdom(),
+            final_state(),
+            summary(),
+            velocity(),
+            root_ / kVtkDir,
             rods()};
   }
 
