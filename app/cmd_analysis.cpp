@@ -40,19 +40,35 @@ std::string join(const std::vector<std::string>& v) {
   return s;
 }
 
-/// python/ibrod_report.py: $IBROD_REPORT_SCRIPT, else beside the source tree of a build directory
-/// (build/app/ibrod → python/), else installed beside the binary (../share/ibrod/).
+/// python/ibrod_report.py (with ibrod_plot.py and ibrod_study.py beside it), the first found of:
+///   $IBROD_REPORT_SCRIPT;
+///   installed beside the binary: <bindir>/<IBROD_SCRIPTS_FROM_BINDIR>/ (cmake --install: bin/ →
+///   share/ibrod/; pip install: ibrod/bin/ → ibrod/share/ibrod/);
+///   the source tree this binary was built from (IBROD_SOURCE_PYTHON_DIR: any build directory);
+///   ../../python/ from the binary (an in-tree build/app/ibrod moved with its source tree).
 std::filesystem::path report_script() {
   namespace fs = std::filesystem;
   if (const char* env = std::getenv("IBROD_REPORT_SCRIPT")) return env;
   std::error_code ec;
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec)
-    for (const fs::path& p : {exe.parent_path() / "../../python/ibrod_report.py",
-                              exe.parent_path() / "../share/ibrod/ibrod_report.py"})
-      if (fs::exists(p)) return fs::weakly_canonical(p);
-  throw ibrod::ConfigError(
-      "ibrod report: python/ibrod_report.py not found (set IBROD_REPORT_SCRIPT to its path)");
+  std::vector<fs::path> where;
+  if (!ec) where.push_back(exe.parent_path() / IBROD_SCRIPTS_FROM_BINDIR / "ibrod_report.py");
+  where.push_back(fs::path(IBROD_SOURCE_PYTHON_DIR) / "ibrod_report.py");
+  if (!ec) where.push_back(exe.parent_path() / "../../python/ibrod_report.py");
+  std::string looked;
+  for (const fs::path& p : where) {
+    if (fs::is_regular_file(p, ec)) return fs::weakly_canonical(p);
+    looked += (looked.empty() ? "" : ", ") + p.lexically_normal().string();
+  }
+  throw ibrod::ConfigError("ibrod report: python/ibrod_report.py not found (looked in " + looked +
+                           "; set IBROD_REPORT_SCRIPT to its path)");
+}
+
+/// The Python that runs the report: $IBROD_PYTHON (the pip-installed `ibrod` command sets it to
+/// its environment's interpreter), else Debian's /usr/bin/python3 (numpy, matplotlib).
+std::string report_python() {
+  const char* env = std::getenv("IBROD_PYTHON");
+  return env && *env ? env : "/usr/bin/python3";
 }
 
 }  // namespace
@@ -70,7 +86,8 @@ void add_analysis_commands(CLI::App& app) {
       const std::string script = report_script().string();
       std::error_code ec;
       const std::string self = std::filesystem::read_symlink("/proc/self/exe", ec).string();
-      std::vector<std::string> args{"/usr/bin/python3", script};
+      const std::string python = report_python();
+      std::vector<std::string> args{python, script};
       for (const auto& r : report->remaining()) args.push_back(r);
       if (!ec) args.insert(args.end(), {"--ibrod", self});
       std::vector<char*> argv;
@@ -78,8 +95,7 @@ void add_analysis_commands(CLI::App& app) {
       argv.push_back(nullptr);
       std::fflush(stdout);
       ::execv(argv[0], argv.data());
-      throw ibrod::RunError(std::string("ibrod report: cannot run /usr/bin/python3: ") +
-                            std::strerror(errno));
+      throw ibrod::RunError("ibrod report: cannot run " + python + ": " + std::strerror(errno));
     });
   });
 
@@ -108,7 +124,7 @@ void add_analysis_commands(CLI::App& app) {
       ->capture_default_str();
   analyze->add_flag(
       "--frames", a->opt.every_frame,
-      "also the shape of every frame of DIR/trajectory.h5 (summary.json shape_frames)");
+      "also the shape of every frame of DIR/trajectory.h5md (summary.json shape_frames)");
   analyze
       ->add_option("--contact-distance", a->opt.contact_distance_A,
                    "contact distance d_c in Å (default: D + 3 Debye lengths of config.toml)")
@@ -138,7 +154,7 @@ void add_analysis_commands(CLI::App& app) {
   render->add_option("dir", r->dir, "run directory (written by ibrod run)")->required();
   render
       ->add_option("--time", r->opt.times,
-                   "time in µs (nearest frame of DIR/trajectory.h5) or 'final'; repeatable or "
+                   "time in µs (nearest frame of DIR/trajectory.h5md) or 'final'; repeatable or "
                    "comma-separated (default: final)")
       ->delimiter(',');
   render
@@ -159,7 +175,7 @@ void add_analysis_commands(CLI::App& app) {
   render->add_flag("!--no-labels", r->opt.labels,
                    "no time, Wr, ΔLk, Cs and scale bar on the pictures");
   render->add_flag("--movie", r->opt.movie,
-                   "every frame of DIR/trajectory.h5 from the first view, at one scale, into "
+                   "every frame of DIR/trajectory.h5md from the first view, at one scale, into "
                    "DIR/render/movie_<view>/frame_NNNNN.png, as the animated PNG "
                    "DIR/render/rod_<view>.apng, and DIR/render/rod_<view>.mp4 with ffmpeg if "
                    "installed");

@@ -3,7 +3,7 @@
 vector PDF/SVG with --format) in the layout of a paper.
 
     python/ibrod_report.py RUN_DIR... -o REPORT_DIR [--view oblique] [--ibrod BINARY] [--frames]
-                           [--tau-window US] [--format png|pdf|svg]
+                           [--tau-window US] [--format png|pdf|svg] [--html [--html-frames N]]
 
 Writes into REPORT_DIR:
   report.md           the runs; tables with rows ΔLk and columns Cs of the writhe convergence
@@ -21,6 +21,9 @@ Writes into REPORT_DIR:
                       over rod.perturbation_random.seed at one ΔLk, Cs): one picture per final
                       shape class, with its count and energy (report.md: "Perturbation sampling")
 (.pdf or .svg instead of .png with --format; the contact sheet stays PNG, as it holds pictures).
+  report.html         with --html: the whole report as one self-contained page that opens offline
+                      (python/ibrod_html.py): a 3-D view of each run's rod with a time slider,
+                      Wr and ΔLk, the tables, the figures (PNG/SVG embedded) and a picture per cell
 Titles carry the grid (n³, box) of the runs.
 
 report.md also says, for each (ΔLk, Cs), whether the twisted circle was stable as the stability
@@ -533,6 +536,12 @@ def main(argv=None):
     p.add_argument("--format", choices=FORMATS, default="png",
                    help="format of the plots (vs_excess_link, timeseries): png, or vector pdf/svg; "
                         "the contact sheet is always PNG")
+    p.add_argument("--html", action="store_true",
+                   help="also REPORT_DIR/report.html: one self-contained page with a 3-D view of "
+                        "each run's rod (rotate, zoom, time slider), the tables and the figures "
+                        "(python/ibrod_html.py)")
+    p.add_argument("--html-frames", type=int, default=100, metavar="N",
+                   help="with --html: at most N frames of each trajectory in the 3-D view")
     a = p.parse_args(argv)
 
     if a.ibrod:
@@ -629,6 +638,11 @@ def main(argv=None):
     with open(os.path.join(a.output, "report.md"), "w") as f:
         f.write("\n".join(md))
     print(os.path.join(a.output, "report.md"))
+    if a.html:
+        from ibrod_html import write_html
+        page = os.path.join(a.output, "report.html")
+        write_html(page, "\n".join(md), a.output, a.runs, max(1, a.html_frames))
+        print(page)
     return 0
 
 

@@ -5,13 +5,14 @@ thermal runs against kT times its mobility from deterministic runs pulled by ext
     python3 python/thermal_einstein.py --pull-x DIR --pull-z DIR --force-pN F \
         --thermal DIR [DIR ...] [--lags 10 20 50] [--figure docs/figures/thermal_einstein.png]
 
-Each run directory needs trajectory.h5 (frames). The pulls: the ring in the xy plane pulled along
+Each run directory needs trajectory.h5md (frames). The pulls: the ring in the xy plane pulled along
 x (edgewise) and along z (broadside); mobility = slope of the centroid / F. The thermal runs: D(τ)
 = ⟨|Δc(τ)|²⟩ / (6τ) over non-overlapping windows of each run, averaged over the runs; its error
 bar is the standard error over those independent windows (runs × windows).
 """
 import argparse
 import json
+import os
 
 import h5py
 import numpy as np
@@ -19,8 +20,15 @@ import numpy as np
 KB = 1.380649e-16 * 1e16  # g Å² s⁻² K⁻¹
 
 
+def trajectory(run):
+    """run/trajectory.h5md, or an older run's trajectory.h5."""
+    old = os.path.join(run, "trajectory.h5")
+    new = os.path.join(run, "trajectory.h5md")
+    return old if os.path.exists(old) and not os.path.exists(new) else new
+
+
 def centroids(run):
-    with h5py.File(run + "/trajectory.h5", "r") as f:
+    with h5py.File(trajectory(run), "r") as f:
         g = f["particles"]
         name = list(g.keys())[0]
         pos = g[name]["position"]["value"][:]

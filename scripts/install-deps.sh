@@ -18,7 +18,9 @@ packages=(
   zlib1g-dev            # the animated PNG of render --movie (deflate, CRC)
   python3 python3-numpy python3-matplotlib python3-h5py python3-pil   # analysis, plots; Pillow reads the movie in a test
   python3-dev pybind11-dev python3-pytest   # the Python module ibrod (docs/python.md) and its tests
-  python3-mdanalysis    # tests: MDAnalysis reads trajectory.h5 (H5MD)
+  python3-venv python3-setuptools python3-wheel   # pip install --no-build-isolation . into a venv (docs/python.md)
+  python3-mdanalysis    # tests: MDAnalysis reads trajectory.h5md (H5MD)
+  chromium              # tests: headless Chromium draws the HTML report's 3-D view (--html)
   python3-vtk9          # tests: VTK's own readers open the .vtp/.vti files
   ffmpeg                # render --movie encodes the frames as MP4 (and ffprobe for its test)
 )

@@ -7,7 +7,7 @@ from thermal IB runs against a Monte-Carlo sample of the same energy (mc_ring).
         [--label 'ΔLk = 0'] [--skip-us 0.1] [--ib2 ... --mc2 ... --label2 ...] \
         [--figure docs/figures/thermal_mc.png]
 
-IB: writhe and energies from timeseries.csv, shapes from the frames of trajectory.h5, the first
+IB: writhe and energies from timeseries.csv, shapes from the frames of trajectory.h5md, the first
 --skip-us of each run dropped (equilibration from the circle). Error bars: each series is cut into
 blocks of at least 10 integrated autocorrelation times (τ_int estimated from the series itself,
 Sokal's window c = 6), the mean and the standard deviation computed per block, and their errors
@@ -16,12 +16,20 @@ the same way, its time unit the row (10 sweeps).
 """
 import argparse
 import csv
+import os
 
 import h5py
 import numpy as np
 
 STATS = ["writhe", "rg_A", "P2_A2", "P3_A2"]
 ENERGIES = ["E_bend_kT", "E_twist_kT", "E_stretch_kT", "E_pairs_kT"]
+
+
+def trajectory(run):
+    """run/trajectory.h5md, or an older run's trajectory.h5."""
+    old = os.path.join(run, "trajectory.h5")
+    new = os.path.join(run, "trajectory.h5md")
+    return old if os.path.exists(old) and not os.path.exists(new) else new
 
 
 def shape_stats(pos):
@@ -46,7 +54,7 @@ def read_ib(run, skip_us):
         [float(r["E_electro_kT"]) + float(r["E_steric_kT"]) for r in rows])[keep]
     ser["link"] = np.array([float(r["link"]) for r in rows])[keep]
     dt_row = t[1] - t[0]
-    with h5py.File(run + "/trajectory.h5", "r") as f:
+    with h5py.File(trajectory(run), "r") as f:
         g = f["particles/rod/position"]
         pos = g["value"][:]
         tf = g["time"][:]

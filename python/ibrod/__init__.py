@@ -27,7 +27,7 @@ from ._core import Config as _CoreConfig
 from ._core import ConfigError, RunError
 from ._core import Simulation as _CoreSimulation
 
-__all__ = ["Config", "Simulation", "ConfigError", "RunError", "read_run"]
+__all__ = ["Config", "Simulation", "ConfigError", "RunError", "read_run", "trajectory_path"]
 ConfigError.__module__ = RunError.__module__ = "ibrod"  # shown as ibrod.ConfigError
 
 
@@ -143,14 +143,24 @@ def _triads(d1, d2, d3):
     return np.stack([d1, d2, d3], axis=-2)
 
 
+def trajectory_path(path):
+    """The H5MD trajectory of run directory `path`: trajectory.h5md, or trajectory.h5 of a run
+    written before the file took H5MD's extension; None when there is neither."""
+    for name in ("trajectory.h5md", "trajectory.h5"):
+        p = os.path.join(os.fspath(path), name)
+        if os.path.exists(p):
+            return p
+    return None
+
+
 def read_run(path):
     """Read a run directory (of `ibrod run` or Simulation(output=...)) into numpy arrays.
 
     Returns a dict with:
       "timeseries":  dict column -> (R,) array (timeseries.csv: step, time_us, energies in kT, …)
       "frames":      dict "step" (T,), "time_us" (T,), "positions" (T, n, 3) Å, "triads"
-                     (T, n, 3, 3) (row i = D^(i+1)) from trajectory.h5; None without one (needs
-                     h5py)
+                     (T, n, 3, 3) (row i = D^(i+1)) from trajectory.h5md (or an older run's
+                     trajectory.h5); None without one (needs h5py)
       "final_state": dict "positions" (n, 3), "triads" (n, 3, 3) from final_state.csv, or None;
                      with several rods also "rod" (n,): each point's rod
       "rods":        several rods: rods.csv as dict column -> (R,) array (step, time_us,
@@ -163,7 +173,7 @@ def read_run(path):
     path = os.fspath(path)
     if not os.path.isdir(path):
         raise FileNotFoundError(f"read_run: {path} is not a directory")
-    names = ("timeseries.csv", "trajectory.h5", "final_state.csv", "summary.json", "config.toml",
+    names = ("timeseries.csv", "trajectory.h5md", "trajectory.h5", "final_state.csv", "summary.json", "config.toml",
              "rods.csv")
     if not any(os.path.exists(os.path.join(path, n)) for n in names):
         raise FileNotFoundError(f"read_run: {path} holds none of a run's files ({', '.join(names)})"
@@ -204,8 +214,8 @@ def read_run(path):
                 out["config"] = tomllib.load(fh)
         except (OSError, ValueError) as e:  # tomllib.TOMLDecodeError
             raise _damaged(p, e) from e
-    p = os.path.join(path, "trajectory.h5")
-    if os.path.exists(p):
+    p = trajectory_path(path)
+    if p is not None:
         import h5py
 
         # without file locking, as ibrod writes it (io/h5md.cpp): a Simulation of this process
@@ -213,9 +223,13 @@ def read_run(path):
         try:
             with h5py.File(p, "r", locking=False) as h:
                 rod = h["particles/rod"]
+                t = rod["position/time"]
+                unit = t.attrs.get("unit", b"ns")
+                unit = unit.decode() if isinstance(unit, bytes) else str(unit)
                 out["frames"] = {
                     "step": rod["position/step"][()],
-                    "time_us": rod["position/time"][()],
+                    # ns since the units are MDAnalysis's; µs in the oldest files
+                    "time_us": t[()] * (1.0 if unit == "µs" else 1e-3),
                     "positions": rod["position/value"][()],
                     "triads": _triads(rod["d1/value"][()], rod["d2/value"][()],
                                       rod["d3/value"][()]),

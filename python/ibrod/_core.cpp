@@ -14,6 +14,8 @@
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <optional>
@@ -93,6 +95,15 @@ class PySimulation {
     return run_->simulation();
   }
 
+  // An end time as config.toml shows it: 12 significant digits, so that 200 steps of 0.1 ns
+  // read 0.02, not 0.020000000000000004 (the change, ≤ 1e-12 relative, is far below the half
+  // step within which a segment ends; the segment still ends after exactly `steps` steps).
+  static double decimal_us(double t) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.12g", t);
+    return std::strtod(buf, nullptr);
+  }
+
   py::dict run(std::optional<std::int64_t> steps, std::optional<double> until_us) {
     sim::Simulation& sm = s();
     if (steps && until_us) throw std::invalid_argument("run: give steps or until_us, not both");
@@ -103,7 +114,7 @@ class PySimulation {
                                     "; a positive number of steps is allowed");
       max_steps = *steps;
       // the segment ends after `steps` steps of Δt (implicit: steps of at most Δt)
-      run_->set_end_time((sm.time() + double(*steps) * sm.dt()) / 1e-6);
+      run_->set_end_time(decimal_us((sm.time() + double(*steps) * sm.dt()) / 1e-6));
     } else if (until_us) {
       if (!(*until_us * 1e-6 > sm.time() + 0.5 * sm.dt()))
         throw std::invalid_argument(
@@ -329,7 +340,7 @@ One trajectory of ibrod, on the same C++ core as `ibrod run`.
 
 Simulation(cfg, output=None, overwrite=False, progress=False): builds the initial state of cfg
 (the twisted circle, or rod.initial_shape). With output="DIR" the run writes the usual run
-directory (config.toml, timeseries.csv, trajectory.h5, checkpoint.bin, final_state.csv,
+directory (config.toml, timeseries.csv, trajectory.h5md, checkpoint.bin, final_state.csv,
 summary.json; docs/outputs.md); an existing non-empty DIR is refused unless overwrite=True.
 With output=None nothing is written. progress=True prints the CLI's progress lines.
 )doc")

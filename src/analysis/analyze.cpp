@@ -266,7 +266,7 @@ json to_json(const Analysis& a, const AnalyzeOptions& opt) {
     contacts["source"] = nullptr;
     contacts["note"] = sh.contacts.note;
   } else {
-    contacts["source"] = "trajectory.h5";
+    contacts["source"] = sh.contacts.source;
     contacts["frames"] = sh.contacts.time_us.size();
     json changes = json::array();
     for (std::size_t i = 1; i < sh.contacts.time_us.size(); ++i)

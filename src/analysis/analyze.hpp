@@ -42,7 +42,7 @@ struct AnalyzeOptions {
   diagnostics::WindowOptions fit;  ///< final-window fits (ln E_K; tolerance in ln units)
   diagnostics::TransientOptions transients;
   double contact_distance_A = 0;  ///< d_c of contacts and plies; 0: D + 3 λ_D of config.toml
-  bool every_frame = false;       ///< `--frames`: the shape of every frame of trajectory.h5
+  bool every_frame = false;       ///< `--frames`: the shape of every frame of trajectory.h5md
   double tau_window_us = 1.0;     ///< width of the windows of τ(t)
 };
 
@@ -77,7 +77,7 @@ struct Analysis {
   std::optional<double> relaxation_time_us;  ///< τ of E_K ∝ exp(−2t/τ) on the final tolerance
                                              ///< window; none if E_K does not decay
   std::optional<FitWindow> relaxation_fit;
-  // τ after the last contact formed (docs/analysis.md): contacts from trajectory.h5
+  // τ after the last contact formed (docs/analysis.md): contacts from trajectory.h5md
   std::optional<double> contacts_settled_time_us;
   std::optional<double> relaxation_time_contacts_us;
   std::optional<FitWindow> relaxation_contacts_fit;

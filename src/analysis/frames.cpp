@@ -1,4 +1,4 @@
-// The rod's frames of a run directory (final_state.csv, trajectory.h5) and `ibrod render`.
+// The rod's frames of a run directory (final_state.csv, trajectory.h5md) and `ibrod render`.
 #include "analysis/frames.hpp"
 
 #include <toml++/toml.h>
@@ -246,7 +246,7 @@ std::vector<fs::path> render_run(const fs::path& dir, const RenderOptions& opt, 
     } else {
       if (log)
         std::fprintf(log,
-                     "render: no trajectory.h5 in %s: drawing the final state instead of "
+                     "render: no trajectory.h5md in %s: drawing the final state instead of "
                      "--time\n",
                      dir.c_str());
       want_final = true;

@@ -1,6 +1,6 @@
 #pragma once
 // The rod's configurations in a run directory — the final state (final_state.csv) and the frames
-// of trajectory.h5 — and `ibrod render`, which draws them into DIR/render/*.png.
+// of trajectory.h5md — and `ibrod render`, which draws them into DIR/render/*.png.
 // Missing or malformed input files throw ConfigError (exit status 2), failed writes RunError (3).
 #include <cstdint>
 #include <cstdio>
@@ -27,13 +27,13 @@ struct RodFrame {
 /// of timeseries.csv).
 RodFrame read_final_state(const std::filesystem::path& dir);
 
-/// The frames of DIR/trajectory.h5 nearest to each of `times_us` (each frame once, in time
+/// The frames of DIR/trajectory.h5md nearest to each of `times_us` (each frame once, in time
 /// order). ConfigError if the file is missing or has no frames.
 /// span_us (if given): the first and last frame times.
 std::vector<RodFrame> read_trajectory_frames(const std::filesystem::path& dir,
                                              std::span<const double> times_us,
                                              std::pair<double, double>* span_us = nullptr);
-/// Every frame of DIR/trajectory.h5, in time order (ConfigError as above).
+/// Every frame of DIR/trajectory.h5md, in time order (ConfigError as above).
 std::vector<RodFrame> read_all_trajectory_frames(const std::filesystem::path& dir);
 
 struct RenderOptions {
@@ -52,7 +52,7 @@ struct RenderOptions {
 /// [16, 8192].
 void parse_size(const std::string& text, int& width, int& height);
 
-/// Renders the rod of DIR at the requested times (frames of DIR/trajectory.h5; without one, the
+/// Renders the rod of DIR at the requested times (frames of DIR/trajectory.h5md; without one, the
 /// final state, with a note on `log`) from each view into DIR/render/rod_<view>_t<time>.png,
 /// time in µs with 4 decimals, tube diameter steric.diameter_A of DIR/config.toml. A time
 /// outside the trajectory's span is drawn at the nearest frame with a warning on stderr. A

@@ -20,7 +20,7 @@ double default_contact_distance(double diameter_A, double salt_M) {
 
 namespace {
 
-/// Every frame's positions of DIR/trajectory.h5 (time, X).
+/// Every frame's positions of DIR/trajectory.h5md (time, X).
 std::vector<RodFrame> read_positions(const fs::path& p) {
   io::H5mdSeries pos;
   try {
@@ -55,14 +55,15 @@ ShapeAnalysis analyze_shapes(const fs::path& dir, double contact_distance_A, boo
       out.final_shape = ShapeRecord{f.time_us, diagnostics::analyze_shape(f.X, opt)};
   }
   if (!fs::exists(rd.trajectory())) {
-    out.contacts.note = "no trajectory.h5 (output.frame_every_steps = 0?)";
+    out.contacts.note = "no trajectory.h5md (output.frame_every_steps = 0?)";
     return out;
   }
   const auto frames = read_positions(rd.trajectory());
   if (frames.size() < 2) {
-    out.contacts.note = "trajectory.h5 holds fewer than 2 frames";
+    out.contacts.note = rd.trajectory().filename().string() + " holds fewer than 2 frames";
     return out;
   }
+  out.contacts.source = rd.trajectory().filename().string();
   for (const RodFrame& f : frames) {
     if (f.X.size() < 8) continue;
     // a continued run may rewrite a stretch: keep times increasing, the later frames win

@@ -1,7 +1,7 @@
 #pragma once
 // The shapes and contacts of a run directory for `ibrod analyze` (docs/analysis.md "Shapes" and
 // "Relaxation time after the last contact"): the shape of the final state (final_state.csv),
-// optionally of every frame of trajectory.h5, and the number of contact clusters per frame.
+// optionally of every frame of trajectory.h5md, and the number of contact clusters per frame.
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -22,11 +22,12 @@ struct ShapeRecord {
 };
 
 /// Contact clusters (diagnostics::contact_clusters at d_c, pairs ≥ 2 d_c apart along the rod) of
-/// every frame of trajectory.h5; empty `time_us` and a `note` when there is none.
+/// every frame of trajectory.h5md; empty `time_us` and a `note` when there is none.
 struct ContactHistory {
   std::vector<double> time_us;
   std::vector<int> clusters;
-  std::string note;  ///< why there is no history ("" when there is one)
+  std::string note;    ///< why there is no history ("" when there is one)
+  std::string source;  ///< the trajectory's file name (trajectory.h5md, or an old run's .h5)
 };
 
 struct ShapeAnalysis {
@@ -36,7 +37,7 @@ struct ShapeAnalysis {
   ContactHistory contacts;
 };
 
-/// Reads DIR/final_state.csv and DIR/trajectory.h5 (when present) and analyses them with
+/// Reads DIR/final_state.csv and DIR/trajectory.h5md (when present) and analyses them with
 /// `opt` (its contact_distance_A replaced by `contact_distance_A`). Every frame's shape only
 /// when `every_frame`; the contacts of every frame always (they are cheap: O(n²) per frame).
 ShapeAnalysis analyze_shapes(const std::filesystem::path& dir, double contact_distance_A,

@@ -95,7 +95,7 @@ struct Config {
   // [steric]
   bool steric_enabled = true;
   double steric_diameter_A = 20.0;    ///< D, Å
-  double steric_stiffness_kT_A2 = 0;  ///< g, kT/Å²; set from interactions::kDefaultStericStiffness
+  double steric_stiffness_kT_A2 = 0;  ///< g, kT/Å²; 0.1 by default (Config())
   // [output]
   std::int64_t output_every_steps = 1000;      ///< output.every_steps: steps between rows
   std::int64_t output_frame_every_steps = -1;  ///< steps between trajectory frames; 0: none;

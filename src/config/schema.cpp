@@ -28,7 +28,9 @@ using rod::RandomPerturbation;
 
 Config::Config()
     : electrostatics_cutoff_debye(interactions::kDefaultCutoffDebye),
-      steric_stiffness_kT_A2(interactions::kDefaultStericStiffness / units::kT(300.0)) {}
+      // 0.1 kT/Å² as written in config.toml, not interactions::kDefaultStericStiffness (41.419
+      // g s⁻², from kT(300 K) rounded to 414.19) converted back, which read 0.0999988652679525
+      steric_stiffness_kT_A2(0.1) {}
 
 namespace {
 
@@ -273,7 +275,7 @@ Key initial_shape_key() {
   k.name = "rod.initial_shape";
   k.help =
       "start from this shape instead of the twisted circle: a run's final_state.csv, or "
-      "\"trajectory.h5@FRAME\" (FRAME from 0, -1 the last); \"\": the circle";
+      "\"trajectory.h5md@FRAME\" (FRAME from 0, -1 the last); \"\": the circle";
   k.set = [](Config& c, const toml::node& n) {
     const auto v = n.value_exact<std::string>();
     if (!v) bad("rod.initial_shape", show(n), "a file name in quotes, or \"\" for the circle");

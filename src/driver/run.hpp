@@ -4,7 +4,7 @@
 // named by io::RunDir (docs/outputs.md describes each):
 //   config.toml        the resolved configuration (every key)
 //   timeseries.csv     one row per output step (columns: timeseries_header())
-//   trajectory.h5      H5MD trajectory: frames every output.frame_every_steps, observables, config
+//   trajectory.h5md      H5MD trajectory: frames every output.frame_every_steps, observables, config
 //   rod.pvd, vtk/      ParaView series of the rod (.vtp), with every frame
 //   fluid.pvd          ParaView series of the fluid velocity (.vti; output.fluid_vti)
 //   checkpoint.bin     full state at the latest checkpoint (start, every

@@ -56,7 +56,7 @@ void prepare_output_dir(const io::RunDir& run_dir, bool overwrite, std::optional
 }
 
 // ---------------------------------------------------------------------------------------------
-// Output files that grow during the run: timeseries.csv, trajectory.h5, rod.pvd (+ fluid.pvd).
+// Output files that grow during the run: timeseries.csv, trajectory.h5md, rod.pvd (+ fluid.pvd).
 
 std::string summary_json(const config::Config& c, const RunResult& r, const CheckpointMeta& meta,
                          std::int64_t frames, const std::string& stop_reason,

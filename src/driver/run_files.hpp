@@ -1,5 +1,5 @@
 #pragma once
-// The files of a run directory that grow while it runs — timeseries.csv, trajectory.h5, rod.pvd
+// The files of a run directory that grow while it runs — timeseries.csv, trajectory.h5md, rod.pvd
 // (+ fluid.pvd) — and the ones written at its end (summary.json); driver::Run's writers.
 #include <sys/stat.h>
 
@@ -208,7 +208,7 @@ class RunFiles {
       const std::filesystem::path aside = dir_.damaged_trajectory(last);
       std::filesystem::rename(path, aside, ec);
       progress.message(std::string("ibrod: warning: ") + e.what() + "; moved it to " +
-                       aside.string() + "; trajectory.h5 restarts at step " +
+                       aside.string() + "; trajectory.h5md restarts at step " +
                        std::to_string(last + 1));
       h5_ = io::H5mdWriter::create(path, n, box_A, config_text);
     }

@@ -371,9 +371,10 @@ std::unique_ptr<H5mdWriter> H5mdWriter::create(const std::filesystem::path& path
     Hid box = cx.group(rod, "box", true);
     int_attribute(cx, box, "dimension", {3}, true);
     string_attribute(cx, box, "boundary", {"periodic", "periodic", "periodic"}, false);
-    // time-dependent (step, time, value [T, 3]) although the box never changes: H5MD allows a
-    // fixed dataset, but MDAnalysis's H5MD reader reads box/edges/value per frame
-    m.box = Impl::make(cx, box, "edges", {3}, kLengthUnit);
+    // time-dependent (step, time, value [T, 3, 3]) although the box never changes: H5MD allows
+    // a fixed dataset, but MDAnalysis's H5MD reader reads box/edges/value per frame, and as the
+    // D × D matrix of the box vectors (H5MD allows a D-vector too, which it reads as no box)
+    m.box = Impl::make(cx, box, "edges", {3, 3}, kLengthUnit);
     m.box_A = box_A;
     for (int e2 = 0; e2 < 4; ++e2)
       m.rod[e2] =
@@ -389,6 +390,12 @@ std::unique_ptr<H5mdWriter> H5mdWriter::create(const std::filesystem::path& path
       if (H5Dwrite(d, H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT, species.data()) < 0)
         cx.fail("write dataset species");
     }
+    // /particles/trajectory: a soft link to /particles/rod, the one group name that
+    // MDAnalysis's H5MD reader counts atoms in when it opens the file alone
+    // (mda.Universe("trajectory.h5md"), H5MDReader.parse_n_atoms); its reader itself takes the
+    // first group, rod
+    if (H5Lcreate_soft("/particles/rod", particles, "trajectory", H5P_DEFAULT, H5P_DEFAULT) < 0)
+      cx.fail("create the link /particles/trajectory");
   }
   {
     Hid obs = cx.group(m.file, "observables", true);
@@ -421,7 +428,10 @@ std::unique_ptr<H5mdWriter> H5mdWriter::reopen(const std::filesystem::path& path
       if (e == 0) w->frames_ = std::int64_t(kept);
     }
     Hid box = cx.group(rod, "box", false);
-    m.box = Impl::open(cx, box, "edges", {3});
+    // the edges as this file holds them: [T, 3, 3], or [T, 3] in files written before
+    const std::vector<hsize_t> edges = shape(cx, cx.dataset(box, "edges/value"));
+    m.box = Impl::open(cx, box, "edges",
+                       edges.size() == 2 ? std::vector<hsize_t>{3} : std::vector<hsize_t>{3, 3});
     Impl::truncate(cx, m.box, last_step);
     m.box_A = box_A;
   }
@@ -449,8 +459,9 @@ void H5mdWriter::write_frame(std::int64_t step, double time_us, const rod::RodSt
         m.buf[3 * std::size_t(k) + i] = e == 0 ? s.X[k][i] : s.D[k](i, e - 1);
     m.append(m.rod[e], step, time_us, m.buf.data());
   }
-  const double edges[3] = {m.box_A, m.box_A, m.box_A};
-  m.append(m.box, step, time_us, edges);
+  const double L = m.box_A;
+  const double matrix[9] = {L, 0, 0, 0, L, 0, 0, 0, L}, vector[3] = {L, L, L};
+  m.append(m.box, step, time_us, m.box.inner.size() == 2 ? matrix : vector);
   m.flush();
   ++frames_;
 }

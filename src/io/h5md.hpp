@@ -5,8 +5,10 @@
 //   /h5md                         attribute version = [1, 1]
 //   /h5md/author                  attribute name ($USER)
 //   /h5md/creator                 attributes name = "ibrod", version
+//   /particles/trajectory         soft link to /particles/rod (MDAnalysis counts atoms there)
 //   /particles/rod/box            attributes dimension = 3, boundary = ["periodic" × 3];
-//                                 dataset edges [3] f64, Å
+//                                 edges: step, time, value [T, 3, 3] f64, Å (the box vectors as
+//                                 rows; [T, 3] in older files, which are extended so)
 //   /particles/rod/position       step [T] i64, time [T] f64 (µs), value [T, n, 3] f64 (Å,
 //                                 unwrapped: never folded into the box)
 //   /particles/rod/d1, d2, d3     step, time, value [T, n, 3]: the triad columns D¹, D², D³

@@ -105,8 +105,11 @@ rod::RodState read_rod_shape(const std::string& spec, const std::string& key, in
   std::string path;
   long long frame = -1;
   if (split_frame(spec, path, frame)) return from_h5md(path, frame, key);
-  if (spec.size() > 3 && spec.compare(spec.size() - 3, 3, ".h5") == 0)
-    return from_h5md(spec, -1, key);
+  const auto ends_with = [&spec](const std::string& tail) {
+    return spec.size() > tail.size() &&
+           spec.compare(spec.size() - tail.size(), tail.size(), tail) == 0;
+  };
+  if (ends_with(".h5md") || ends_with(".h5")) return from_h5md(spec, -1, key);
   std::error_code ec;
   if (!std::filesystem::exists(spec, ec))
     throw ConfigError(key + " = '" + spec + "': no such file");

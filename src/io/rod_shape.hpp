@@ -1,6 +1,6 @@
 #pragma once
 // The rod's shape from a file (`rod.initial_shape`): a run's final_state.csv, or one frame of an
-// H5MD trajectory (trajectory.h5), so that a run can start where another one ended.
+// H5MD trajectory (trajectory.h5md), so that a run can start where another one ended.
 #include <string>
 
 #include "rod/rod.hpp"

@@ -2,7 +2,10 @@
 // The names of every file of a run directory, in one place (docs/outputs.md describes each):
 //   config.toml        the resolved configuration (every key)
 //   timeseries.csv     one row per output step (io/observables.hpp: timeseries_header())
-//   trajectory.h5      H5MD trajectory: frames, observables, config (io/h5md.hpp)
+//   trajectory.h5md    H5MD trajectory: frames, observables, config (io/h5md.hpp); the
+//                      extension is H5MD's, so that MDAnalysis and other readers know the
+//                      format by name. Older run directories have trajectory.h5
+//                      (the same layout): read, resumed and extended under that name
 //   rod.pvd, vtk/      ParaView series of the rod (.vtp), with every frame (io/vtk.hpp)
 //   fluid.pvd          ParaView series of the fluid velocity (.vti; output.fluid_vti)
 //   checkpoint.bin     the full state at the latest checkpoint (io/checkpoint.hpp)
@@ -29,10 +32,20 @@ class RunDir {
   std::filesystem::path timeseries() const { return root_ / "timeseries.csv"; }
   /// several rods: each rod's writhe, twist and link at every row (docs/outputs.md)
   std::filesystem::path rods() const { return root_ / "rods.csv"; }
-  std::filesystem::path trajectory() const { return root_ / "trajectory.h5"; }
-  /// where a trajectory.h5 that cannot be reopened on resume is moved (kept for inspection)
+  /// The run's H5MD trajectory: trajectory.h5md, or the legacy trajectory.h5 of an older run
+  /// when that one exists and trajectory.h5md does not (so an old run is read and resumed in
+  /// place, never split over two files).
+  std::filesystem::path trajectory() const {
+    std::error_code ec;
+    const std::filesystem::path current = root_ / kTrajectory, legacy = root_ / kLegacyTrajectory;
+    if (!std::filesystem::exists(current, ec) && std::filesystem::exists(legacy, ec)) return legacy;
+    return current;
+  }
+  static constexpr const char* kTrajectory = "trajectory.h5md";
+  static constexpr const char* kLegacyTrajectory = "trajectory.h5";
+  /// where a trajectory that cannot be reopened on resume is moved (kept for inspection)
   std::filesystem::path damaged_trajectory(std::int64_t step) const {
-    return root_ / ("trajectory.damaged-" + std::to_string(step) + ".h5");
+    return root_ / ("trajectory.damaged-" + std::to_string(step) + ".h5md");
   }
   std::filesystem::path checkpoint() const { return root_ / "checkpoint.bin"; }
   std::filesystem::path wisdom() const { return root_ / "fftw.wisdom"; }
@@ -51,7 +64,8 @@ class RunDir {
   /// run, with the frames of vtk/ that is_frame_file names; nothing else: a file of the user's
   /// in the directory or in vtk/ is kept).
   std::vector<std::filesystem::path> run_files() const {
-    return {config(),     timeseries(), trajectory(),  root_ / "rod.pvd", root_ / "fluid.pvd",
+    return {config(),     timeseries(), root_ / kTrajectory, root_ / kLegacyTrajectory,
+            root_ / "rod.pvd", root_ / "fluid.pvd",
             checkpoint(), wisdom(),     final_state(), summary(),         velocity(),
             rods()};
   }

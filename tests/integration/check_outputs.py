@@ -2,13 +2,14 @@
 """End to end: the files of `ibrod run` open with standard tools alone, and agree with each other.
 
 Runs IBROD (argv[1]) on a small configuration, then checks
-  trajectory.h5  with h5py: the H5MD layout (docs/outputs.md), step/time/value shapes and types,
+  trajectory.h5md  with h5py: the H5MD layout (docs/outputs.md), step/time/value shapes and types,
                  the observables against timeseries.csv, the config against config.toml and the
                  last frame against final_state.csv;
   rod.pvd, vtk/*.vtp, fluid.pvd, vtk/*.vti  with xml.etree: VTKFile type/version/byte_order,
                  one Piece, array sizes against NumberOfPoints/NumberOfLines/extents, component
                  counts, a closed polyline, points equal to the H5MD frames, DataSet files present.
-  trajectory.h5  with MDAnalysis's H5MD reader too (frames, positions, time units);
+  trajectory.h5md  with MDAnalysis too, opened by name (mda.Universe(path)): atoms, frames,
+                 positions, times, box;
   vtk/*.vtp, vtk/*.vti  with VTK's own readers too (python3-vtk9: vtkXMLPolyDataReader,
                  vtkXMLImageDataReader): points, the closed line, arrays, dimensions, spacing;
 Exit status 0 if every check passes; the first failed check is printed.
@@ -56,16 +57,21 @@ def numbers(array_el):
 
 
 def check_h5md(d):
-    f = h5py.File(os.path.join(d, "trajectory.h5"), "r")
+    f = h5py.File(os.path.join(d, "trajectory.h5md"), "r")
     check(list(f["h5md"].attrs["version"]) == [1, 1], "/h5md version [1, 1]")
     check(len(f["h5md/author"].attrs["name"]) > 0, "/h5md/author name")
     check(f["h5md/creator"].attrs["name"] == "ibrod", "/h5md/creator name")
     check(len(f["h5md/creator"].attrs["version"]) > 0, "/h5md/creator version")
+    # the particle group rod, and the soft link MDAnalysis counts atoms in (docs/outputs.md)
+    check(sorted(f["particles"].keys()) == ["rod", "trajectory"], "/particles: rod, trajectory")
+    check(f["particles"].get("trajectory", getlink=True).path == "/particles/rod",
+          "/particles/trajectory links to /particles/rod")
     box = f["particles/rod/box"]
     check(int(box.attrs["dimension"]) == 3, "box dimension 3")
     check([str(b) for b in box.attrs["boundary"]] == ["periodic"] * 3, "box boundary periodic")
-    check(np.allclose(box["edges/value"][()], [[BOX] * 3] * len(range(0, STEPS + 1, FRAME_EVERY))),
-          "box edges, one record per frame")
+    check(np.allclose(box["edges/value"][()],
+                      [np.diag([BOX] * 3)] * len(range(0, STEPS + 1, FRAME_EVERY))),
+          "box edges: the box vectors as a 3 × 3 matrix, one record per frame")
 
     frames = list(range(0, STEPS + 1, FRAME_EVERY))
     for el in ("position", "d1", "d2", "d3"):
@@ -116,16 +122,17 @@ def check_h5md(d):
 
 
 def check_mdanalysis(d, positions):
-    """MDAnalysis's own H5MD reader opens the trajectory: frames, positions in Å, times in ps."""
+    """MDAnalysis opens the trajectory by its name alone (the .h5md extension tells the format):
+    N atoms, every frame with its positions in Å, its time in ps and the periodic box."""
     import MDAnalysis as mda
-    u = mda.Universe.empty(N, trajectory=True)
-    u.load_new(os.path.join(d, "trajectory.h5"), format="H5MD")
+    u = mda.Universe(os.path.join(d, "trajectory.h5md"))
+    check(len(u.atoms) == N, "MDAnalysis: %d atoms" % len(u.atoms))
     traj = u.trajectory
     check(len(traj) == len(positions), "MDAnalysis: %d frames" % len(traj))
-    for ts, x in zip(traj, positions):
+    for i, (ts, x) in enumerate(zip(traj, positions)):
         check(np.allclose(ts.positions, x, rtol=1e-5, atol=1e-3), "MDAnalysis: positions in Å")
-    traj[1]
-    check(abs(traj.ts.time - FRAME_EVERY * 0.1 * 1e3) < 1e-6, "MDAnalysis: time in ps")
+        check(abs(ts.time - i * FRAME_EVERY * 0.1 * 1e3) < 1e-6, "MDAnalysis: time in ps")
+        check(np.allclose(ts.dimensions, [BOX] * 3 + [90.0] * 3), "MDAnalysis: box")
 
 
 def check_vtkfile(path, kind):

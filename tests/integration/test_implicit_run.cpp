@@ -136,7 +136,7 @@ TEST(ImplicitRun, RowsInSimulatedTimeFallOnTheirMultiplesAndAnExtensionIsBitwise
   for (std::size_t i = 0; i < t.size(); ++i) EXPECT_NEAR(t[i], 0.01 * double(i), 1e-12) << i;
   const std::vector<double> steps = column(root / "ref" / "timeseries.csv", "step");
   EXPECT_GT(steps.back(), 2.0 * 20);  // several steps a row: Δt ≤ 3 ns, rows 10 ns apart
-  const io::H5mdSeries fr = io::read_h5md_series(root / "ref" / "trajectory.h5", "position");
+  const io::H5mdSeries fr = io::read_h5md_series(root / "ref" / "trajectory.h5md", "position");
   ASSERT_EQ(fr.time_us.size(), 6u);  // frames at 0, 0.04, …, 0.2 µs
   for (std::size_t i = 0; i < fr.time_us.size(); ++i)
     EXPECT_NEAR(fr.time_us[i], 0.04 * double(i), 1e-12) << i;

@@ -120,7 +120,7 @@ TEST(MpiRun, TwoRanksShareTheFluidGridAndAgreeWithOneProcess) {
   expect_same_trajectory(d / "one", d / "two");
   // the same outputs as a one-process run (rank 0 wrote them)
   for (const char* f :
-       {"config.toml", "summary.json", "trajectory.h5", "checkpoint.bin", "fftw.wisdom", "rod.pvd"})
+       {"config.toml", "summary.json", "trajectory.h5md", "checkpoint.bin", "fftw.wisdom", "rod.pvd"})
     EXPECT_TRUE(fs::exists(d / "two" / f)) << f;
   fs::remove_all(d);
 }

@@ -152,7 +152,7 @@ TEST(TimeIsState, AChangedTimeStepOnResumeKeepsTheTimeContinuousAndMonotone) {
   EXPECT_NEAR(t.back(), 0.016, 1e-9);
   EXPECT_DOUBLE_EQ(step.back(), 1120);  // 120 steps of 0.1 ns, 1000 of 0.004 ns
   // the H5MD frames carry the same continuous time
-  const io::H5mdSeries pos = io::read_h5md_series(out / "trajectory.h5", "position");
+  const io::H5mdSeries pos = io::read_h5md_series(out / "trajectory.h5md", "position");
   for (std::size_t i = 1; i < pos.time_us.size(); ++i)
     EXPECT_GT(pos.time_us[i], pos.time_us[i - 1]);
   EXPECT_NEAR(pos.time_us.back(), 0.016, 1e-9);
@@ -234,8 +234,8 @@ TEST(Extension, ALaterEndTimeAloneNeedsNoForceAndEqualsTheUninterruptedLongerRun
   EXPECT_THAT(e.output, HasSubstr("extending the run"));
   EXPECT_EQ(read_file(d / "ext" / "timeseries.csv"), read_file(d / "ref" / "timeseries.csv"));
   EXPECT_EQ(read_file(d / "ext" / "final_state.csv"), read_file(d / "ref" / "final_state.csv"));
-  const io::H5mdSeries a = io::read_h5md_series(d / "ext" / "trajectory.h5", "position");
-  const io::H5mdSeries b = io::read_h5md_series(d / "ref" / "trajectory.h5", "position");
+  const io::H5mdSeries a = io::read_h5md_series(d / "ext" / "trajectory.h5md", "position");
+  const io::H5mdSeries b = io::read_h5md_series(d / "ref" / "trajectory.h5md", "position");
   EXPECT_EQ(a.step, b.step);
   EXPECT_EQ(a.value, b.value);
   // another change still needs --force

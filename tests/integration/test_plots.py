@@ -89,7 +89,7 @@ class PlotsAndReport(unittest.TestCase):
                 self.assertIsNone(s[key], key)
             # the final shape of a 300-step run: still the circle; contacts from the frames
             self.assertEqual(s["shape"]["class"], "circle")
-            self.assertEqual(s["contacts"]["source"], "trajectory.h5")
+            self.assertEqual(s["contacts"]["source"], "trajectory.h5md")
             self.assertEqual(s["contacts"]["frames"], 16)
         with open(os.path.join(self.a, "summary.json")) as f:
             frames = json.load(f)["shape_frames"]  # --frames: one shape per frame
@@ -101,7 +101,7 @@ class PlotsAndReport(unittest.TestCase):
         self.assertEqual(len(files), 2, r.stdout)
         img = self.png(files[0])
         self.assertEqual(img.shape[:2], (180, 240))
-        # --time picks the nearest frame of trajectory.h5 (frames every 0.002 µs)
+        # --time picks the nearest frame of trajectory.h5md (frames every 0.002 µs)
         r = sh(BINARY, "render", self.a, "--time", "0.0123", "--views", "side", "--size", "64x64")
         self.assertIn("frame at t = 0.0120 us", r.stdout)
         self.png(os.path.join(self.a, "render", "rod_side_t0.0120.png"))
@@ -143,7 +143,7 @@ class PlotsAndReport(unittest.TestCase):
         self.assertTrue(0 < lo < mean < hi, (lo, mean, hi))
 
     def test_1b_movie(self):
-        # every frame of trajectory.h5 (16: steps 0, 20, …, 300) from the first view, one scale;
+        # every frame of trajectory.h5md (16: steps 0, 20, …, 300) from the first view, one scale;
         # an MP4 with ffmpeg, else a message saying so
         r = sh(BINARY, "render", self.b, "--movie", "--views", "oblique", "--size", "48x40")
         movie = os.path.join(self.b, "render", "movie_oblique")

@@ -36,8 +36,8 @@ void expect_same_run(const fs::path& a, const fs::path& b) {
   EXPECT_EQ(read_file(a / "final_state.csv"), read_file(b / "final_state.csv"));
   EXPECT_EQ(read_file(a / "rod.pvd"), read_file(b / "rod.pvd"));
   for (const char* e : {"position", "d1", "d2", "d3"}) {
-    const io::H5mdSeries sa = io::read_h5md_series(a / "trajectory.h5", e);
-    const io::H5mdSeries sb = io::read_h5md_series(b / "trajectory.h5", e);
+    const io::H5mdSeries sa = io::read_h5md_series(a / "trajectory.h5md", e);
+    const io::H5mdSeries sb = io::read_h5md_series(b / "trajectory.h5md", e);
     EXPECT_EQ(sa.step, sb.step) << e;
     EXPECT_EQ(sa.time_us, sb.time_us) << e;
     EXPECT_TRUE(sa.value == sb.value) << e << ": frames differ";  // bitwise
@@ -171,7 +171,7 @@ TEST_F(Restart, DamagedOrForeignCheckpointsAreRefused) {
 TEST_F(Restart, AFullDiskStopsWithAMessageAndTheRunCanBeResumed) {
   const fs::path f = root_ / "F";
   // At most 200 kB per file (RLIMIT_FSIZE: writes beyond fail with EFBIG, as on a full disk):
-  // the checkpoint (~110 kB) fits, trajectory.h5 (~110 kB + ~10 kB per frame) outgrows it
+  // the checkpoint (~110 kB) fits, trajectory.h5md (~110 kB + ~10 kB per frame) outgrows it
   // mid-run. (A real disk that fills up is met earlier, by the free-space check before writes.)
   Exit e = run_ibrod(run_args("F"), root_ / "F1.log", 200 * 1024);
   ASSERT_EQ(e.code, 3) << e.output;

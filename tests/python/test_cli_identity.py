@@ -93,8 +93,8 @@ def test_initial_shape_from_final_state_and_trajectory(binary, tmp_path, cfg):
     np.testing.assert_array_equal(b["frames"]["positions"][0], A["final_state"]["positions"])
     np.testing.assert_array_equal(b["frames"]["triads"][0], A["final_state"]["triads"])
     # an H5MD frame: PATH@FRAME (from 0; -1 the last)
-    for spec, frame in ((f"{a}/trajectory.h5@2", 2), (f"{a}/trajectory.h5@-1", -1),
-                        (f"{a}/trajectory.h5", -1)):
+    for spec, frame in ((f"{a}/trajectory.h5md@2", 2), (f"{a}/trajectory.h5md@-1", -1),
+                        (f"{a}/trajectory.h5md", -1)):
         c["rod.initial_shape"] = spec
         s = ibrod.Simulation(c)
         np.testing.assert_array_equal(s.positions, A["frames"]["positions"][frame])
@@ -105,7 +105,7 @@ def test_initial_shape_errors(binary, tmp_path, cfg):
     a = cli_run(binary, cfg, tmp_path, "a")
     cases = [
         (str(tmp_path / "missing.csv"), "no such file"),
-        (f"{a}/trajectory.h5@9", "5 frames"),
+        (f"{a}/trajectory.h5md@9", "5 frames"),
         (f"{a}/timeseries.csv", "no column x_A"),
     ]
     for spec, words in cases:

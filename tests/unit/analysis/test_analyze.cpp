@@ -214,7 +214,7 @@ TEST(Analyze, UnfinishedRunGivesNullWithAReasonNeverANumber) {
   // no trajectory: the table's τ is the final-window fit, and the summary says so
   EXPECT_EQ(j["relaxation_time_method"], "final_window");
   EXPECT_NEAR(j["relaxation_time_table_us"].get<double>(), 0.25, 1e-6);
-  EXPECT_NE(j["relaxation_contacts_note"].get<std::string>().find("no trajectory.h5"),
+  EXPECT_NE(j["relaxation_contacts_note"].get<std::string>().find("no trajectory.h5md"),
             std::string::npos);
   EXPECT_TRUE(j["contacts"]["source"].is_null());
 }
@@ -292,7 +292,7 @@ TEST(RenderRun, FinalStateFromCsvIntoNamedFiles) {
   opt.views = {"top", "side"};
   opt.width = 96;
   opt.height = 64;
-  opt.times = {"0.1"};  // no trajectory.h5: the final state instead
+  opt.times = {"0.1"};  // no trajectory.h5md: the final state instead
   const auto files = render_run(d.path, opt, nullptr);
   ASSERT_EQ(files.size(), 2u);
   EXPECT_EQ(files[0], d.path / "render" / "rod_top_t0.2500.png");
