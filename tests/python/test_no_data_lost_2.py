@@ -92,7 +92,7 @@ def test_read_run_drops_a_cut_last_row_names_damaged_files_and_refuses_an_empty_
     run = ibrod.read_run(out)
     assert list(run["timeseries"]["step"]) == [0, 50, 100]
     for name, damage in [("summary.json", '{"steps": 1'), ("config.toml", "[grid\n"),
-                         ("trajectory.h5", "not HDF5"), ("final_state.csv", "x_A,y_A\n1,2\n")]:
+                         ("trajectory.h5md", "not HDF5"), ("final_state.csv", "x_A,y_A\n1,2\n")]:
         good = (out / name).read_bytes()
         (out / name).write_text(damage)
         with pytest.raises(ValueError, match=name):
