@@ -19,8 +19,8 @@
 using namespace ibrod;
 
 int main(int argc, char** argv) {
-  std::map<std::string, std::string> kv{{"dt_ns", "4.4"}, {"steps", "200"}, {"beta", "8"},
-                                        {"adaptive", "0"}, {"every", "1"}};
+  std::map<std::string, std::string> kv{
+      {"dt_ns", "4.4"}, {"steps", "200"}, {"beta", "8"}, {"adaptive", "0"}, {"every", "1"}};
   config::Config cfg;
   for (const char* s : {"grid.n=64", "grid.box_A=725", "rod.base_pairs=600", "rod.excess_link=5",
                         "run.threads=1", "run.fftw_measure=false"})
@@ -46,7 +46,8 @@ int main(int argc, char** argv) {
   integrate::AdaptiveDtParams ap = p.adaptive;
   ap.dt_max = dt;
   ap.dt_min = 1e-3 * dt;
-  if (!(ap.max_displacement > 0)) ap.max_displacement = std::stod(kv.count("dmax") ? kv["dmax"] : "1.92");
+  if (!(ap.max_displacement > 0))
+    ap.max_displacement = std::stod(kv.count("dmax") ? kv["dmax"] : "1.92");
   integrate::AdaptiveDt ctl(ap);
   const bool adaptive = kv["adaptive"] == "1";
   const int steps = std::stoi(kv["steps"]), every = std::stoi(kv["every"]);
@@ -87,7 +88,8 @@ int main(int argc, char** argv) {
     if (s % every == 0 || s == steps - 1)
       std::printf("%d %.4f %.4g %.4e %.3e %.4e %+.4f %d%s\n", s, t * 1e9, h * 1e9, ek,
                   (info.energy_after - info.energy_before) / p.kT, umax * 1e-9, cosv,
-                  imp.contacts(), prev_contacts >= 0 && prev_contacts != imp.contacts() ? " *" : "");
+                  imp.contacts(),
+                  prev_contacts >= 0 && prev_contacts != imp.contacts() ? " *" : "");
     prev_contacts = imp.contacts();
   }
   return 0;

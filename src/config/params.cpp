@@ -384,7 +384,8 @@ sim::SimParams to_params(const Config& c) {
   p.implicit.krylov_tol = c.time_implicit_krylov_tol;
   // issue 24: the two-stage step and its error control (order 1 has no estimate: off)
   p.implicit.order = c.time_implicit_order;
-  p.adaptive.error_tolerance = c.time_implicit_order == 2 ? c.time_error_tolerance_A * angstrom : 0.0;
+  p.adaptive.error_tolerance =
+      c.time_implicit_order == 2 ? c.time_error_tolerance_A * angstrom : 0.0;
   return p;
 }
 

@@ -37,15 +37,15 @@ bool AdaptiveDt::judge(const StepOutcome& o) {
   const bool control = p_.error_tolerance > 0;
   // error control: the factor the estimate asks for (err ∝ Δt²)
   double ef = p_.grow_max;
-  if (control && o.error > 0) ef = std::clamp(0.9 * std::sqrt(p_.error_tolerance / o.error), 0.2,
-                                              p_.grow_max);
+  if (control && o.error > 0)
+    ef = std::clamp(0.9 * std::sqrt(p_.error_tolerance / o.error), 0.2, p_.grow_max);
   const bool bad = !o.finite || !o.converged || !(ratio <= 1.0) ||
                    !(o.energy_change <= p_.energy_tolerance) ||
                    (control && !(o.error <= p_.error_tolerance));
   if (bad && !(at_floor && o.finite)) {
     // shrink by `shrink`, or further if the displacement or the error asks for it
-    const bool error_only = o.finite && o.converged && ratio <= 1.0 &&
-                            o.energy_change <= p_.energy_tolerance;
+    const bool error_only =
+        o.finite && o.converged && ratio <= 1.0 && o.energy_change <= p_.energy_tolerance;
     double f = error_only ? std::min(ef, 0.9) : p_.shrink;
     if (std::isfinite(ratio) && ratio > 1.0) f = std::min(f, 0.9 / ratio);
     if (control && o.error > p_.error_tolerance) f = std::min(f, ef);
@@ -64,8 +64,10 @@ bool AdaptiveDt::judge(const StepOutcome& o) {
     // a step the caller shortened (an output time, t_end) does not hold Δt back unless its own
     // error asks for less
     const bool capped = o.dt > 0 && o.dt < dt_;
-    if (!capped) dt_ = dt_ * f;
-    else if (f < 1) dt_ = std::min(dt_, o.dt * f);
+    if (!capped)
+      dt_ = dt_ * f;
+    else if (f < 1)
+      dt_ = std::min(dt_, o.dt * f);
     dt_ = std::clamp(dt_, p_.dt_min, p_.dt_max);
     return true;
   }

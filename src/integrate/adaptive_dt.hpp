@@ -27,8 +27,8 @@ struct AdaptiveDtParams {
   /// Δt ← Δt · clamp(0.9 √(tol/err), 0.2, grow_max), rejecting steps with err > tol
   double error_tolerance = 0.0;
   double grow_max = 2.0;  ///< largest growth factor of one step under error control
-  double shrink = 0.5;            ///< Δt factor on rejection
-  double grow = 1.25;             ///< Δt factor after grow_after accepted steps
+  double shrink = 0.5;    ///< Δt factor on rejection
+  double grow = 1.25;     ///< Δt factor after grow_after accepted steps
   int grow_after = 4;
 };
 

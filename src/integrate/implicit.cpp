@@ -41,7 +41,8 @@ ImplicitStepper::ImplicitStepper(Stepper& stepper, const ImplicitParams& p)
   if (!(p_.mobility_scale >= 0)) throw std::invalid_argument("ImplicitStepper: mobility_scale < 0");
   if (p_.krylov_max_iter < 0) throw std::invalid_argument("ImplicitStepper: krylov_max_iter < 0");
   if (p_.jacobian_every < 1) throw std::invalid_argument("ImplicitStepper: jacobian_every < 1");
-  if (p_.order != 1 && p_.order != 2) throw std::invalid_argument("ImplicitStepper: order not 1 or 2");
+  if (p_.order != 1 && p_.order != 2)
+    throw std::invalid_argument("ImplicitStepper: order not 1 or 2");
   if (p_.order == 2 && (p_.krylov_max_iter > 0 || !p_.velocity_form || !(p_.mobility_scale > 0)))
     throw std::invalid_argument(
         "ImplicitStepper: order 2 needs the velocity form, mobility_scale > 0 and no GMRES");
@@ -203,7 +204,7 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
     return x;
   };
   std::vector<Vec3> aF(n), aT(n), aU(n), aW(n);
-  const std::vector<Vec3>* at = &s.X;            // where M is taken (ROS2's stage: elsewhere)
+  const std::vector<Vec3>* at = &s.X;             // where M is taken (ROS2's stage: elsewhere)
   auto apply_mobility = [&](const VectorXd& g) {  // M g: one Stokes solve
     unpack(g, aF, aT);
     const double t0 = now();

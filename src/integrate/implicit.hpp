@@ -64,8 +64,8 @@ struct ImplicitParams {
   /// force evaluations per step, with the embedded first-order qⁿ + Δt k₁ for the error
   /// estimate Δt ½ (k₁ + k₂) (docs/large_dt.md "Error control and order"). Velocity form only.
   int order = 1;
-  double fd_dx = 1e-4;          ///< finite-difference step of K in positions, Å
-  double fd_dtheta = 1e-5;      ///< ... and in rotation vectors, rad
+  double fd_dx = 1e-4;      ///< finite-difference step of K in positions, Å
+  double fd_dtheta = 1e-5;  ///< ... and in rotation vectors, rad
 };
 
 /// What one implicit step did (for the adaptive controller and the logs).

@@ -154,8 +154,8 @@ TEST(ImplicitOrder2, ErrorControlFollowsTheExplicitPathWhereTheFixedCapDoesNot) 
   Ring r2(8.0, 2, 4), r1(8.0, 1, 4);
   const double e2 = run_adaptive(r2, 2e-9, 0.1, T);
   const double e1 = run_adaptive(r1, 2e-9, 0.0, T);
-  std::printf("E at 150 ns: explicit %.3f, ROS2 + error control %.3f, order 1 %.3f kT\n", e_ex,
-              e2, e1);
+  std::printf("E at 150 ns: explicit %.3f, ROS2 + error control %.3f, order 1 %.3f kT\n", e_ex, e2,
+              e1);
   EXPECT_NEAR(e2, e_ex, 2.0);
   EXPECT_GT(std::abs(e1 - e_ex), 5.0);  // today's default cap: another state
 }

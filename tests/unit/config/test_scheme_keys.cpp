@@ -52,7 +52,8 @@ TEST(SchemeKeys, AnUnknownSchemeOrABadKnobNamesTheKey) {
   config::apply_override(c, "time.scheme=\"implicit\"");
   config::apply_override(c, "time.dt_min_ns=1");  // above time.dt_ns = 0.1
   EXPECT_THROW(config::validate(c), ConfigError);
-}TEST(SchemeKeys, OrderTwoAndItsErrorToleranceReachTheParameters) {
+}
+TEST(SchemeKeys, OrderTwoAndItsErrorToleranceReachTheParameters) {
   config::Config c;
   config::apply_override(c, "time.scheme=\"implicit\"");
   config::apply_override(c, "time.implicit_order=2");
@@ -77,5 +78,3 @@ TEST(SchemeKeys, AnUnknownSchemeOrABadKnobNamesTheKey) {
   config::apply_override(c, "time.implicit_krylov_iterations=0");
   EXPECT_THROW(config::apply_override(c, "time.implicit_order=3"), std::exception);
 }
-
-

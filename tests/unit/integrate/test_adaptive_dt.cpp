@@ -113,7 +113,6 @@ TEST(AdaptiveDt, RejectsInconsistentParameters) {
   EXPECT_THROW(AdaptiveDt(params(), 0.0, 0), std::invalid_argument);
 }
 
-
 // ---- error control (issue 24): Δt follows the local error estimate, err ∝ Δt²
 TEST(AdaptiveDt, ErrorControlRejectsAboveTheToleranceAndShrinksBySquareRoot) {
   AdaptiveDtParams p = params();
