@@ -45,11 +45,16 @@ struct Config {
   double time_energy_tolerance_kT = 1e-6;   ///< implicit: allowed energy rise per step, kT
   double time_dt_min_ns = 0;                ///< implicit: smallest step, ns (0: time.dt_ns / 1000)
   double time_implicit_mobility_scale = 8;  ///< implicit: β of M_loc
-  int time_implicit_jacobian_every = 1;     ///< implicit: steps between stiffness refreshes
-  int time_implicit_krylov_iterations = 0;  ///< implicit: GMRES iterations (0: IMEX)
-  double time_implicit_krylov_tol = 1e-2;   ///< implicit: GMRES relative residual
-  int time_implicit_order = 1;              ///< implicit: 1 (IMEX Euler) or 2 (ROS2), issue 24
-  double time_error_tolerance_A = 0.1;      ///< implicit, order 2: local error per step, Å (0: off)
+  /// implicit: M_loc "self" (β × the self mobility, diagonal) or "overlap" (the kernel overlap,
+  /// issue 24)
+  std::string time_implicit_local_mobility = "self";
+  double time_implicit_overlap_scale = 1;        ///< implicit: β of the overlap M_loc
+  int time_implicit_overlap_refresh_every = 10;  ///< implicit, overlap: steps between its LUs
+  int time_implicit_jacobian_every = 1;          ///< implicit: steps between stiffness refreshes
+  int time_implicit_krylov_iterations = 0;       ///< implicit: GMRES iterations (0: IMEX)
+  double time_implicit_krylov_tol = 1e-2;        ///< implicit: GMRES relative residual
+  int time_implicit_order = 1;                   ///< implicit: 1 (IMEX Euler) or 2 (ROS2), issue 24
+  double time_error_tolerance_A = 0.1;  ///< implicit, order 2: local error per step, Å (0: off)
   // [rod]
   int rod_base_pairs = 600;                         ///< rod.base_pairs: rod points n
   int rod_excess_link = 6;                          ///< rod.excess_link: ΔLk (integer)

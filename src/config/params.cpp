@@ -378,8 +378,13 @@ sim::SimParams to_params(const Config& c) {
   p.adaptive.max_displacement = c.time_max_displacement_A * angstrom;
   p.adaptive.energy_tolerance = c.time_energy_tolerance_kT * p.kT;
   p.adaptive.dt_min = c.time_dt_min_ns * ns;
-  p.implicit.mobility_scale = c.time_implicit_mobility_scale;
-  p.implicit.jacobian_every = c.time_implicit_jacobian_every;
+  const bool overlap = c.time_implicit_local_mobility == "overlap";
+  p.implicit.local_mobility = overlap ? integrate::ImplicitParams::LocalMobility::overlap
+                                      : integrate::ImplicitParams::LocalMobility::self;
+  p.implicit.mobility_scale =
+      overlap ? c.time_implicit_overlap_scale : c.time_implicit_mobility_scale;
+  p.implicit.jacobian_every =
+      overlap ? c.time_implicit_overlap_refresh_every : c.time_implicit_jacobian_every;
   p.implicit.krylov_max_iter = c.time_implicit_krylov_iterations;
   p.implicit.krylov_tol = c.time_implicit_krylov_tol;
   // issue 24: the two-stage step and its error control (order 1 has no estimate: off)

@@ -213,6 +213,28 @@ Key scheme_key() {
   return k;
 }
 
+// time.implicit_local_mobility: "self" or "overlap" (issue 24)
+Key local_mobility_key() {
+  Key k;
+  k.name = "time.implicit_local_mobility";
+  k.help =
+      "implicit: the local mobility M_loc of the implicit solve: \"self\" (the kernel's self "
+      "mobility on the diagonal, × time.implicit_mobility_scale) or \"overlap\" (the kernel "
+      "overlap, which the Stokes mobility's near-null space shares, × "
+      "time.implicit_overlap_scale; docs/large_dt.md)";
+  k.set = [](Config& c, const toml::node& n) {
+    const auto v = n.value_exact<std::string>();
+    if (!v || (*v != "self" && *v != "overlap"))
+      bad("time.implicit_local_mobility", show(n), "\"self\" or \"overlap\"");
+    c.time_implicit_local_mobility = *v;
+  };
+  k.put = [](const Config& c, toml::table& t) {
+    t.insert_or_assign("implicit_local_mobility", c.time_implicit_local_mobility);
+  };
+  k.value = [](const Config& c) { return "\"" + c.time_implicit_local_mobility + "\""; };
+  return k;
+}
+
 // rod.intrinsic_curvature_per_A = [Ω¹₀, Ω²₀]: exactly two numbers (checked before any is set)
 Key intrinsic_curvature_key() {
   const std::string name = "rod.intrinsic_curvature_per_A";
@@ -388,6 +410,15 @@ const std::vector<Key>& schema() {
            "implicit: smallest step, ns, always accepted (0: time.dt_ns/1000)"),
       real("time.implicit_mobility_scale", &Config::time_implicit_mobility_scale, 0, true, 1e6,
            "implicit: local mobility M_loc = this × the kernel's self mobility"),
+      local_mobility_key(),
+      real("time.implicit_overlap_scale", &Config::time_implicit_overlap_scale, 0, true, 1e6,
+           "implicit, time.implicit_local_mobility = \"overlap\": M_loc = this × the kernel "
+           "overlap scaled to the self mobility"),
+      integer("time.implicit_overlap_refresh_every", &Config::time_implicit_overlap_refresh_every,
+              1, 1000000,
+              "implicit, time.implicit_local_mobility = \"overlap\": steps between refreshes of "
+              "M_loc, the stiffness and their LU (which costs ~10 Stokes solves at the "
+              "reference; > 1: a run resumed after a signal is not bitwise the same)"),
       integer("time.implicit_jacobian_every", &Config::time_implicit_jacobian_every, 1, 1000000,
               "implicit: steps between refreshes of the stiffness and its factorisation (> 1: "
               "faster; a run resumed after a signal is then not bitwise the same)"),

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "integrate/local_mobility.hpp"
 
 namespace ibrod::integrate {
 
@@ -60,6 +61,11 @@ ImplicitStepper::ImplicitStepper(Stepper& stepper, const ImplicitParams& p)
   mobility(X, Z, std::vector<Vec3>{Vec3(0, 0, 1)}, U, W);
   m_r_ = W[0].z();
   scale_t_ = std::sqrt(m_r_ / m_t_);
+  // the overlap's self blocks at the same point, to scale it to the self mobilities
+  const Eigen::SparseMatrix<double> O1 =
+      kernel_overlap(X, st_.params().grid, st_.params().kernel_width);
+  ov_t_ = std::sqrt(m_t_ / O1.coeff(0, 0));
+  ov_r_ = std::sqrt(m_r_ / O1.coeff(3, 3));
 }
 
 ImplicitStepper::~ImplicitStepper() = default;
@@ -171,7 +177,8 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
       const double t0 = now();
       // the fast path: no contacts, the local system is block-cyclic-tridiagonal
       use_blocks_ = false;
-      if (p_.block_solver && local && p_.gauss_newton && !p_.stiffness_fd &&
+      const bool overlap = p_.local_mobility == ImplicitParams::LocalMobility::overlap;
+      if (p_.block_solver && local && !overlap && p_.gauss_newton && !p_.stiffness_fd &&
           p_.krylov_max_iter == 0 && n >= 3 &&
           (!p_.steric_implicit ||
            detail::add_steric_stiffness(st_.params().steric, s.X, nullptr) == 0)) {
@@ -180,6 +187,20 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
         use_blocks_ = true;
       } else {
         K_ = stiffness(s);
+      }
+      if (overlap && local) {
+        // M_loc = β D O D at qⁿ
+        const double t1 = now();
+        const double reach =
+            4 * st_.params().kernel_width * st_.params().grid.h() / st_.params().rod.ds;
+        const double window = std::min(p_.overlap_window * reach, 0.5 * n);
+        Mov_ = kernel_overlap(s.X, st_.params().grid, st_.params().kernel_width, window,
+                              st_.params().rod.closed);
+        auto d = [&](Eigen::Index i) { return i % 6 < 3 ? ov_t_ : ov_r_; };
+        for (Eigen::Index c = 0; c < Mov_.outerSize(); ++c)
+          for (Eigen::SparseMatrix<double>::InnerIterator it(Mov_, c); it; ++it)
+            it.valueRef() *= p_.mobility_scale * d(it.row()) * d(it.col());
+        timings_.overlap += now() - t1;
       }
       have_K_ = true;
       timings_.stiffness += now() - t0;
@@ -191,7 +212,13 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
   // ROS2 factorises W = I + γΔt M_loc K
   constexpr double kGamma = 1.0 + 0.70710678118654752440;
   const double wdt = p_.order == 2 ? kGamma * dt : dt;
-  if (local && lu_dt_ != wdt) {
+  // the overlap's LU costs more than a step: between refreshes of K it is kept while Δt stays
+  // within [½, 3/2] of the Δt it was made for (W = I + γΔt' M_loc K is a valid W for any Δt',
+  // and the stiff modes' amplification 1 − (Δt/Δt') r x/(1 + x) stays within (−1, 1) for
+  // (Δt/Δt') r < 2)
+  const bool keep = p_.local_mobility == ImplicitParams::LocalMobility::overlap && lu_dt_ > 0 &&
+                    wdt >= 0.5 * lu_dt_ && wdt <= 1.5 * lu_dt_;
+  if (local && lu_dt_ != wdt && !keep) {
     const double t0 = now();
     factorize(wdt);
     timings_.factorize += now() - t0;

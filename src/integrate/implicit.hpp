@@ -64,6 +64,16 @@ struct ImplicitParams {
   /// force evaluations per step, with the embedded first-order qⁿ + Δt k₁ for the error
   /// estimate Δt ½ (k₁ + k₂) (docs/large_dt.md "Error control and order"). Velocity form only.
   int order = 1;
+  /// M_loc: β diag(m_t I, m_r I), the kernel's self mobility on the diagonal (`self`), or
+  /// β D O D, the kernel overlap O = 𝒥𝒮 scaled to the same self blocks
+  /// (integrate/local_mobility.hpp: it shares the Stokes mobility's near-null space; `overlap`,
+  /// solved by sparse LU)
+  enum class LocalMobility { self, overlap };
+  LocalMobility local_mobility = LocalMobility::self;
+  /// overlap: the taper along the rod, in reaches of the kernel along it (4c/Δs points; the
+  /// window is clamped to half the ring): pairs farther apart along the rod than this are left
+  /// out of M_loc, so that close strands of a supercoil do not fill the LU (0: no taper)
+  double overlap_window = 3.0;
   double fd_dx = 1e-4;      ///< finite-difference step of K in positions, Å
   double fd_dtheta = 1e-5;  ///< ... and in rotation vectors, rad
 };
@@ -88,6 +98,8 @@ struct ImplicitStepInfo {
 /// Wall time spent in the parts of ImplicitStepper::step, accumulated, s.
 struct ImplicitTimings {
   double forces = 0, stiffness = 0, factorize = 0, local_solve = 0, stokes = 0;
+  double overlap = 0;  ///< building M_loc = β D O D (in stiffness too)
+  double analyze = 0;  ///< the LU's pattern analysis (in factorize too)
 };
 
 class ImplicitStepper {
@@ -143,7 +155,10 @@ class ImplicitStepper {
   Eigen::SparseMatrix<double> K_;
   Eigen::SparseLU<Eigen::SparseMatrix<double>> lu_;          // full K (not symmetric)
   Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> llt_;    // Gauss–Newton K
-  Eigen::VectorXd mloc_;                                     // diagonal of M_loc
+  Eigen::VectorXd mloc_;                                     // diagonal of M_loc (self)
+  Eigen::SparseMatrix<double> Mov_;                          // M_loc (overlap)
+  double ov_t_ = 1, ov_r_ = 1;                               // D's √c_t, √c_r (overlap)
+  std::vector<int> lu_outer_, lu_inner_;                     // the pattern lu_ analysed
   std::vector<Eigen::Matrix<double, 6, 6>> Kd_, Ko_;         // GN K blocks: K[k][k], K[k+1][k]
   BlockCyclicCholesky bcc_;                                  // their local system, no contacts
   std::vector<Eigen::Matrix<double, 6, 6>> sdiag_, slower_;  // its blocks (scratch)

@@ -272,6 +272,34 @@ Eigen::SparseMatrix<double> ImplicitStepper::stiffness(const rod::RodState& s) {
 }
 
 void ImplicitStepper::factorize(double dt) {
+  if (p_.local_mobility == ImplicitParams::LocalMobility::overlap) {
+    // A = I + Δt M_loc K (velocity form) or I + Δt K M_loc, M_loc banded along the rod and over
+    // close strands: sparse LU, the pattern analysed again whenever it changes
+    Eigen::SparseMatrix<double> A = p_.velocity_form ? Eigen::SparseMatrix<double>(Mov_ * K_)
+                                                     : Eigen::SparseMatrix<double>(K_ * Mov_);
+    A *= dt;
+    for (int i = 0; i < 6 * n_; ++i) A.coeffRef(i, i) += 1.0;
+    A.makeCompressed();
+    const bool same = pattern_ready_ &&
+                      std::equal(lu_outer_.begin(), lu_outer_.end(), A.outerIndexPtr(),
+                                 A.outerIndexPtr() + A.outerSize() + 1) &&
+                      std::size_t(A.nonZeros()) == lu_inner_.size() &&
+                      std::equal(lu_inner_.begin(), lu_inner_.end(), A.innerIndexPtr());
+    if (!same) {
+      const auto t0 = std::chrono::steady_clock::now();
+      lu_.analyzePattern(A);
+      timings_.analyze +=
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      pattern_ready_ = true;
+      lu_outer_.assign(A.outerIndexPtr(), A.outerIndexPtr() + A.outerSize() + 1);
+      lu_inner_.assign(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros());
+    }
+    lu_.factorize(A);
+    if (lu_.info() != Eigen::Success)
+      throw std::runtime_error("ImplicitStepper: the local implicit system is singular");
+    lu_dt_ = dt;
+    return;
+  }
   // M_loc = β diag(m_t I, m_r I)
   mloc_.resize(6 * n_);
   for (int k = 0; k < n_; ++k) {
@@ -338,7 +366,8 @@ Eigen::VectorXd ImplicitStepper::local_solve(const Eigen::VectorXd& v) const {
     bcc_.solve(x);
     return p_.velocity_form ? x : VectorXd(x.cwiseQuotient(mloc_));
   }
-  if (!p_.gauss_newton) return lu_.solve(v);
+  if (!p_.gauss_newton || p_.local_mobility == ImplicitParams::LocalMobility::overlap)
+    return lu_.solve(v);
   // velocity form: (I + Δt M_loc K) x = v ⇔ S x = M_loc⁻¹ v;
   // force form: (I + Δt K M_loc) x = v ⇔ S (M_loc x) = v
   if (p_.velocity_form) return llt_.solve(VectorXd(v.cwiseQuotient(mloc_)));

@@ -204,6 +204,7 @@ std::vector<Case> generated() {
                            "time.energy_tolerance_kT",
                            "time.dt_min_ns",
                            "time.implicit_mobility_scale",
+                           "time.implicit_overlap_scale",
                            "time.implicit_jacobian_every",
                            "time.implicit_krylov_iterations",
                            "time.implicit_krylov_tol"};

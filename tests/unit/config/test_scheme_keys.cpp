@@ -53,6 +53,35 @@ TEST(SchemeKeys, AnUnknownSchemeOrABadKnobNamesTheKey) {
   config::apply_override(c, "time.dt_min_ns=1");  // above time.dt_ns = 0.1
   EXPECT_THROW(config::validate(c), ConfigError);
 }
+TEST(SchemeKeys, TheOverlapLocalMobilityAndItsScaleReachTheParameters) {
+  config::Config c;
+  config::apply_override(c, "time.scheme=\"implicit\"");
+  EXPECT_EQ(config::to_params(c).implicit.local_mobility,
+            integrate::ImplicitParams::LocalMobility::self);
+  EXPECT_DOUBLE_EQ(config::to_params(c).implicit.mobility_scale, 8);
+  config::apply_override(c, "time.implicit_local_mobility=\"overlap\"");
+  config::apply_override(c, "time.implicit_overlap_scale=0.5");
+  config::validate(c);
+  const sim::SimParams p = config::to_params(c);
+  EXPECT_EQ(p.implicit.local_mobility, integrate::ImplicitParams::LocalMobility::overlap);
+  EXPECT_DOUBLE_EQ(p.implicit.mobility_scale, 0.5);  // the overlap's scale, not the self one's
+  EXPECT_EQ(p.implicit.jacobian_every, 10);          // the overlap's refresh
+  config::apply_override(c, "time.implicit_overlap_refresh_every=3");
+  EXPECT_EQ(config::to_params(c).implicit.jacobian_every, 3);
+  EXPECT_THAT(config::to_toml(c), HasSubstr("implicit_local_mobility = 'overlap'"));
+  for (const char* k : {"time.implicit_local_mobility", "time.implicit_overlap_scale",
+                        "time.implicit_overlap_refresh_every"})
+    EXPECT_THAT(config::describe(c), HasSubstr(k));
+  try {
+    config::apply_override(c, "time.implicit_local_mobility=\"banded\"");
+    FAIL() << "accepted banded";
+  } catch (const ConfigError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("time.implicit_local_mobility"));
+    EXPECT_THAT(e.what(), HasSubstr("\"overlap\""));
+  }
+  EXPECT_THROW(config::apply_override(c, "time.implicit_overlap_scale=0"), ConfigError);
+}
+
 TEST(SchemeKeys, OrderTwoAndItsErrorToleranceReachTheParameters) {
   config::Config c;
   config::apply_override(c, "time.scheme=\"implicit\"");
