@@ -38,7 +38,7 @@ int main(int argc, char** argv) {
                                         {"etol", "1e-3"},
                                         {"order", "1"},
                                         {"mloc", "self"},
-                                        {"ov_window", "3"},
+                                        {"ov_window", "0"},
                                         {"err_tol", "0"}};
   config::Config cfg;
   // the experiment's ring: 32³, h as at the reference (11.33 Å), 150 bp, ΔLk = 3, 0.1 M

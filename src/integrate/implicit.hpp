@@ -73,7 +73,7 @@ struct ImplicitParams {
   /// overlap: the taper along the rod, in reaches of the kernel along it (4c/Δs points; the
   /// window is clamped to half the ring): pairs farther apart along the rod than this are left
   /// out of M_loc, so that close strands of a supercoil do not fill the LU (0: no taper)
-  double overlap_window = 3.0;
+  double overlap_window = 0.0;
   double fd_dx = 1e-4;      ///< finite-difference step of K in positions, Å
   double fd_dtheta = 1e-5;  ///< ... and in rotation vectors, rad
 };
