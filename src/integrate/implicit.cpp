@@ -35,7 +35,11 @@ void unpack(const VectorXd& v, std::span<Vec3> a, std::span<Vec3> b) {
 }  // namespace
 
 ImplicitStepper::ImplicitStepper(Stepper& stepper, const ImplicitParams& p)
-    : st_(stepper), p_(p), n_(stepper.params().rod.n) {
+    : st_(stepper),
+      p_(p),
+      rods_(all_rods(stepper.params())),
+      ranges_(rod::ranges_of(rods_)),
+      n_(point_count(stepper.params())) {
   if (st_.params().distributed)
     throw std::invalid_argument("ImplicitStepper: the fluid must not be distributed");
   if (!(p_.mobility_scale >= 0)) throw std::invalid_argument("ImplicitStepper: mobility_scale < 0");
@@ -46,8 +50,8 @@ ImplicitStepper::ImplicitStepper(Stepper& stepper, const ImplicitParams& p)
   if (p_.order == 2 && (p_.krylov_max_iter > 0 || !p_.velocity_form || !(p_.mobility_scale > 0)))
     throw std::invalid_argument(
         "ImplicitStepper: order 2 needs the velocity form, mobility_scale > 0 and no GMRES");
-  work_.resize(n_);
-  for (auto* v : {&U_, &W_, &Fa_, &Ta_, &Fb_, &Tb_}) v->assign(n_, Vec3::Zero());
+  for (auto* v : {&U_, &W_}) v->assign(n_, Vec3::Zero());
+  bcc_.resize(rods_.size());
 
   // Self mobilities of one kernel-spread point: a unit force (torque) at a generic position
   // of the grid, the velocity (angular velocity) interpolated at the same point.
@@ -169,12 +173,16 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
   if (local || p_.krylov_max_iter > 0) {
     if (steps_since_jacobian_ == 0 || !have_K_) {
       const double t0 = now();
-      // the fast path: no contacts, the local system is block-cyclic-tridiagonal
+      // the fast path: no contacts, the local system is block-diagonal over the rods, each
+      // block block-cyclic-tridiagonal (closed) or block-tridiagonal (open)
       use_blocks_ = false;
+      const bool bands = std::all_of(ranges_.begin(), ranges_.end(), [](const rod::RodRange& g) {
+        return g.n >= (g.closed ? 3 : 1);
+      });
       if (p_.block_solver && local && p_.gauss_newton && !p_.stiffness_fd &&
-          p_.krylov_max_iter == 0 && n >= 3 &&
+          p_.krylov_max_iter == 0 && bands &&
           (!p_.steric_implicit ||
-           detail::add_steric_stiffness(st_.params().steric, s.X, nullptr) == 0)) {
+           detail::add_steric_stiffness(st_.steric().params(), s.X, nullptr) == 0)) {
         gn_blocks(s);
         contacts_ = 0;
         use_blocks_ = true;

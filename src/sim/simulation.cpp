@@ -68,17 +68,11 @@ SimParams checked(SimParams p) {
     if (p.more_circles.size() != p.stepper.more_rods.size() ||
         p.more_rotations.size() != p.stepper.more_rods.size())
       throw std::invalid_argument("Simulation: one initial shape per rod");
-    if (p.scheme == TimeScheme::implicit_step)
-      throw std::invalid_argument(
-          "Simulation: the implicit scheme runs one rod only (docs/model.md \"Several rods\")");
     // docs/model.md "Several rods": the stability test's kick is a single rod's; a run of several
     // rods stops at the kinetic-energy rule as it stands
     p.stability.enabled = false;
   }
   if (p.scheme == TimeScheme::implicit_step) {
-    if (!p.stepper.rod.closed)
-      throw std::invalid_argument(
-          "Simulation: the implicit scheme needs a closed rod (its local solve is block-cyclic)");
     if (p.stepper.distributed)
       throw std::invalid_argument("Simulation: the implicit scheme runs on one process only");
     integrate::AdaptiveDtParams& a = p.adaptive;
