@@ -26,6 +26,13 @@ void extract(const RodState& all, const RodRange& r, RodState& out) {
   }
 }
 
+void insert(RodState& all, const RodRange& r, const RodState& one) {
+  for (int k = 0; k < r.n; ++k) {
+    all.X[r.offset + k] = one.X[k];
+    all.D[r.offset + k] = one.D[k];
+  }
+}
+
 void append(RodState& all, const RodState& one) {
   all.X.insert(all.X.end(), one.X.begin(), one.X.end());
   all.D.insert(all.D.end(), one.D.begin(), one.D.end());

@@ -25,6 +25,9 @@ std::vector<RodRange> ranges_of(std::span<const RodParams> rods);
 /// size differs, so a reused `out` allocates nothing).
 void extract(const RodState& all, const RodRange& r, RodState& out);
 
+/// Copies `one` (r.n points) back into rod r's range of the whole state.
+void insert(RodState& all, const RodRange& r, const RodState& one);
+
 /// Appends a rod's state to the whole state.
 void append(RodState& all, const RodState& one);
 

@@ -68,9 +68,6 @@ SimParams checked(SimParams p) {
     if (p.more_circles.size() != p.stepper.more_rods.size() ||
         p.more_rotations.size() != p.stepper.more_rods.size())
       throw std::invalid_argument("Simulation: one initial shape per rod");
-    // docs/model.md "Several rods": the stability test's kick is a single rod's; a run of several
-    // rods stops at the kinetic-energy rule as it stands
-    p.stability.enabled = false;
   }
   if (p.scheme == TimeScheme::implicit_step) {
     if (p.stepper.distributed)

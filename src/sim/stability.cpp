@@ -141,9 +141,15 @@ ProbeOutcome probe_stability(Simulation& sim, const StabilityProbe& p, std::uint
   o.writhe_continuation = continuation.writhe;
   restore();
 
-  // 3. the kicked copy
+  // 3. the kicked copy: every rod of the collection on its own range, in order, each drawing its
+  // kick from the same generator in turn (rod 0's kick is the one a run of that rod alone gets)
   std::mt19937_64 g(p.seed + index);
-  kick(sim.rod(), sim.params().stepper.rod.closed, p, g);
+  rod::RodState one;
+  for (const rod::RodRange& r : sim.rod_ranges()) {
+    rod::extract(sim.rod(), r, one);
+    kick(one, r.closed, p, g);
+    rod::insert(sim.rod(), r, one);
+  }
   o.steps = integrate(sim, saved_time, p.time, kicked);
   o.duration_us = (sim.time() - saved_time) / 1e-6;
   const Observables after = sim.observe();
