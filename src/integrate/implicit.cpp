@@ -85,7 +85,6 @@ bool same_state(const rod::RodState& a, const rod::RodState& b) {
   return a.X.size() == b.X.size() && std::equal(a.X.begin(), a.X.end(), b.X.begin()) &&
          std::equal(a.D.begin(), a.D.end(), b.D.begin());
 }
-double potential(const StepEnergies& e) { return e.elastic.total() + e.electro + e.steric; }
 }  // namespace
 
 namespace {
@@ -166,7 +165,7 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
   const bool local = p_.mobility_scale > 0;
   const Cached& c0 = forces_at(s);
   last_ = c0.E;
-  info.energy_before = potential(c0.E);
+  info.energy_before = c0.E.potential();
   VectorXd b;
   pack(c0.F, c0.T, b);
 
@@ -303,7 +302,7 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
   info.finite = std::isfinite(info.max_displacement) && std::isfinite(info.max_rotation);
   if (info.finite) {
     try {
-      info.energy_after = potential(forces_at(s).E);
+      info.energy_after = forces_at(s).E.potential();
     } catch (const std::exception&) {  // a position out of any range: not finite
       info.finite = false;
     }

@@ -166,6 +166,25 @@ StepEnergies Stepper::compute_forces(const rod::RodState& s) {
   return forces(s, none);
 }
 
+StepEnergies Stepper::energies(const rod::RodState& s) const {
+  StepEnergies e;
+  if (rods_.empty()) {
+    e.elastic = rod::elastic_energy(p_.rod, s);
+  } else {
+    rod::RodState one;
+    for (std::size_t r = 0; r < rods_.size(); ++r) {
+      rod::extract(s, ranges_[r], one);
+      const rod::ElasticEnergy er = rod::elastic_energy(rods_[r], one);
+      e.elastic.bend += er.bend;
+      e.elastic.twist += er.twist;
+      e.elastic.stretch += er.stretch;
+    }
+  }
+  if (p_.electro.enabled) e.electro = electro_.energy(s.X);
+  if (p_.steric.enabled) e.steric = steric_.energy(s.X);
+  return e;
+}
+
 rod::ElasticEnergy Stepper::elastic(const rod::RodState& s) {
   if (rods_.empty()) return rod::elastic_forces(p_.rod, s, work_, F_, T_);
   if (s.size() != int(F_.size()))

@@ -115,23 +115,10 @@ ProbeOutcome probe_stability(Simulation& sim, const StabilityProbe& p, std::uint
   o.E_before_kT = before.E_total_kT;
   o.writhe_before = before.writhe;
 
-  // 1. save
-  const rod::RodState saved_rod = sim.rod();
-  std::vector<double> scratch;
-  const auto u = sim.stepper().whole_velocity(scratch);
-  const std::size_t n3 = sim.params().stepper.grid.size();
-  std::vector<double> saved_u(3 * n3);
-  for (int c = 0; c < 3; ++c) std::copy_n(u[std::size_t(c)], n3, saved_u.begin() + c * n3);
-  const std::int64_t saved_step = sim.step_count();
-  const double saved_time = sim.time();
-  const auto saved_implicit = sim.implicit_state();  // time.scheme = "implicit": its controller
-  auto restore = [&] {
-    sim.rod() = saved_rod;
-    const double* v = saved_u.data();
-    sim.stepper().set_whole_velocity({v, v + n3, v + 2 * n3});
-    sim.restore_clock(saved_step, saved_time);
-    sim.restore_implicit_state(saved_implicit);
-  };
+  // 1. save: the whole dynamical state (Simulation::snapshot, as a checkpoint keeps it)
+  const Snapshot saved = sim.snapshot();
+  const double saved_time = saved.time;
+  auto restore = [&] { sim.restore(saved); };
 
   // 2. the continuation
   Trace cont, kicked;
