@@ -130,6 +130,12 @@ class Simulation {
   const std::vector<rod::RodParams>& rods() const { return rods_; }
   /// Where each rod lies in rod() (rod::RodRange).
   const std::vector<rod::RodRange>& rod_ranges() const { return ranges_; }
+  /// Whether every rod is closed: the collection's link and writhe are defined (sums of each
+  /// rod's), so the progress lines and summary.json report them; else "not defined".
+  bool all_closed() const {
+    return std::all_of(rods_.begin(), rods_.end(),
+                       [](const rod::RodParams& r) { return r.closed; });
+  }
   /// What is wrong with the state, "" if nothing (sim::rods_problem: each rod's spacing, triads,
   /// finiteness; the spacing tolerance widened for thermal noise).
   std::string state_check() const;
