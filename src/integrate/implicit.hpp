@@ -227,7 +227,7 @@ class ImplicitIntegrator {
 
 namespace detail {
 /// The steric contacts' stiffness −∂F_steric/∂X as triplets of the 6n × 6n system (implicit_
-/// stiffness.cpp) over the segments interactions::Steric sees (p.chains: every rod's own, closed
+/// stiffness.cpp) over the segments interactions::Steric sees (p.rods: every rod's own, closed
 /// or open; empty: one rod of all points with p.closed); trip = nullptr: count the contacts
 /// only. Returns the number of contacts.
 int add_steric_stiffness(const interactions::StericParams& p, std::span<const Vec3> X,

@@ -61,11 +61,11 @@ int add_steric_stiffness(const interactions::StericParams& p, std::span<const Ve
   const int n = int(X.size());
   if (!p.enabled || n < 4 || !(p.diameter > 0) || !(p.stiffness > 0)) return 0;
   // the segments [X_a, X_b] as interactions::Steric lists them: each rod's own, in order
-  std::vector<interactions::Chain> chains = p.chains;
-  if (chains.empty()) chains.push_back({0, n, p.ds, p.closed});
+  std::vector<rod::RodRange> chains = p.rods;
+  if (chains.empty()) chains.push_back({0, n, p.closed, p.ds});
   std::vector<int> seg_a, seg_b, seg_chain, seg_pos;
   for (std::size_t r = 0; r < chains.size(); ++r) {
-    const interactions::Chain& c = chains[r];
+    const rod::RodRange& c = chains[r];
     if (c.n < 2) continue;
     for (int k = 0; k < rod::half_points(c.n, c.closed); ++k) {
       seg_a.push_back(c.offset + k);
@@ -78,7 +78,7 @@ int add_steric_stiffness(const interactions::StericParams& p, std::span<const Ve
   // more than 2D apart along the rod (MODEL (2.17)), as Steric; segments of two rods always
   auto far_along_rod = [&](int k, int l) {
     if (seg_chain[k] != seg_chain[l]) return true;
-    const interactions::Chain& c = chains[std::size_t(seg_chain[k])];
+    const rod::RodRange& c = chains[std::size_t(seg_chain[k])];
     const int m = std::abs(seg_pos[k] - seg_pos[l]);
     return (c.closed ? std::min(m, c.n - m) : m) * c.ds > 2 * p.diameter;
   };

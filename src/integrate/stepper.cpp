@@ -36,15 +36,11 @@ ib::XSlab slab_of(const GridSpec& grid, const fluid::DistributedFluid* d) {
   return d ? ib::XSlab{d->x_begin(), d->x_count()} : ib::XSlab{0, grid.n};
 }
 
-// the hard core follows the rod: closed (cyclic segments) or open; with several rods, each its own
+// the hard core follows the rods: each its own segments, closed (cyclic) or open
 interactions::StericParams steric_of(const StepperParams& p) {
   interactions::StericParams s = p.steric;
   s.closed = p.rod.closed;
-  if (!p.more_rods.empty())
-    for (const rod::RodParams& r : all_rods(p)) {
-      const int offset = s.chains.empty() ? 0 : s.chains.back().offset + s.chains.back().n;
-      s.chains.push_back({offset, r.n, r.ds, r.closed});
-    }
+  s.rods = rod::ranges_of(all_rods(p));
   return s;
 }
 }  // namespace

@@ -9,7 +9,7 @@ std::vector<RodRange> ranges_of(std::span<const RodParams> rods) {
   r.reserve(rods.size());
   int offset = 0;
   for (const RodParams& p : rods) {
-    r.push_back({offset, p.n, p.closed});
+    r.push_back({offset, p.n, p.closed, p.ds});
     offset += p.n;
   }
   return r;

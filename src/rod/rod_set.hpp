@@ -11,14 +11,18 @@
 
 namespace ibrod::rod {
 
-/// Where one rod's points lie in the whole state: points offset … offset + n − 1.
+/// The layout of one rod of a collection: where its points lie in the whole state (points
+/// offset … offset + n − 1), closed or open, and its spacing Δs (Å). The one layout type of the
+/// code: the stepper's and the implicit scheme's per-rod loops, the steric segments
+/// (interactions::StericParams::rods), the outputs and the pictures all take it.
 struct RodRange {
   int offset = 0;
   int n = 0;
   bool closed = true;
+  double ds = 3.4;  ///< Å
 };
 
-/// The ranges of rods laid end to end, in order.
+/// The ranges of rods laid end to end, in order (each rod's n, closed and Δs).
 std::vector<RodRange> ranges_of(std::span<const RodParams> rods);
 
 /// Copies rod r's positions and triads out of the whole state into `out` (resized only when its
