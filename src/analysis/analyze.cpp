@@ -63,9 +63,11 @@ RunInfo read_run_info(const fs::path& dir) {
     // several rods: each table resolved on top of [rod], as the run did
     config::Config c;
     config::apply_toml(c, read_text_file(p, "analyze"), p.string());
+    int offset = 0;
     for (int r = 0; r < config::rod_count(c); ++r) {
       const config::Config cr = config::rod_config(c, r);
-      info.rods.push_back({cr.rod_base_pairs, cr.rod_closed});
+      info.rods.push_back({offset, cr.rod_base_pairs, cr.rod_closed, cr.rod_rise_A});
+      offset += cr.rod_base_pairs;
     }
     if (info.rods.size() == 1) info.rods.clear();
   }

@@ -16,6 +16,7 @@
 #include "core/types.hpp"
 #include "diagnostics/relaxation.hpp"
 #include "io/csv.hpp"
+#include "rod/rod_set.hpp"
 
 namespace ibrod::analysis {
 
@@ -29,8 +30,9 @@ struct RunInfo {
   int excess_link = 0;       ///< rod.excess_link
   double salt_M = 0;         ///< solvent.salt_M
   bool closed = true;        ///< rod.closed (an open rod: no closing segment, no Wr or ΔLk)
-  /// several rods ([[rods]]): (points, closed) of each, in the state's order; empty for one rod
-  std::vector<std::pair<int, bool>> rods;
+  /// several rods ([[rods]]): each rod's layout (rod::RodRange), in the state's order; empty for
+  /// one rod
+  std::vector<rod::RodRange> rods;
 };
 /// Reads DIR/config.toml; defaults (diameter 20 Å) for a missing file or key. A file that is not
 /// TOML throws ConfigError.

@@ -339,7 +339,9 @@ std::vector<fs::path> render_run(const fs::path& dir, const RenderOptions& opt, 
         // several rods: each closed rod's writhe (an open one's twist), in order
         std::string w;
         std::size_t off = 0;
-        for (const auto& [m, closed] : info.rods) {
+        for (const rod::RodRange& g : info.rods) {
+          const std::size_t m = std::size_t(g.n);
+          const bool closed = g.closed;
           const std::span<const Vec3> x = std::span<const Vec3>(f.X).subspan(off, std::size_t(m));
           const std::span<const Vec3> d = std::span<const Vec3>(f.d1).subspan(off, std::size_t(m));
           char one[40];

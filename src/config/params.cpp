@@ -40,10 +40,6 @@ void validate(const Config& c) {
       throw ConfigError("[[rods]] table " + std::to_string(r) + ": " + e.what());
     }
   }
-  if (c.time_scheme == "implicit")
-    bad("time.scheme", "\"implicit\"",
-        "\"explicit\" with several rods ([[rods]]; the implicit scheme's local solve is one "
-        "rod's; docs/model.md \"Several rods\")");
 }
 
 namespace {
@@ -56,15 +52,10 @@ void validate_one(const Config& c) {
             " (the kernel must fit in the grid)");
   const double r0 = rod::circle_radius(c.rod_base_pairs, c.rod_rise_A);
   if (!c.rod_closed) {
-    // docs/model.md "Open rods": no link to impose, and the implicit scheme's local solve is
-    // block-cyclic (a closed rod's)
+    // docs/model.md "Open rods": no link to impose
     if (c.rod_excess_link != 0)
       bad("rod.excess_link", std::to_string(c.rod_excess_link),
           "0 with rod.closed = false (an open rod has free ends: no linking number to impose)");
-    if (c.time_scheme == "implicit")
-      bad("time.scheme", "\"implicit\"",
-          "\"explicit\" with rod.closed = false (the implicit scheme's local solve is "
-          "block-cyclic, for a closed rod only; docs/model.md \"Open rods\")");
     // the straight rod plus its hard core must fit in the box
     const double length = (c.rod_base_pairs - 1) * c.rod_rise_A;
     if (length + c.steric_diameter_A >= c.grid_box_A)

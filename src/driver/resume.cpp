@@ -147,18 +147,10 @@ void Run::State::open_checkpoint() {
 
 void Run::State::restore_state() {
   if (checkpoint) {
-    const io::Checkpoint& ck = *checkpoint;
-    meta = ck.meta;
+    meta = checkpoint->meta;
     ++meta.resumes;
-    sim->rod() = ck.rod;
-    const std::size_t n3 = sim->params().stepper.grid.size();
-    const double* v = ck.velocity.data();
-    sim->stepper().set_whole_velocity({v, v + n3, v + 2 * n3});
-    // checkpoints from before time was state: step × Δt of the run that wrote them
-    const double time = meta.time_s >= 0 ? meta.time_s : double(meta.step) * sim->dt();
-    sim->restore_clock(meta.step, time);
-    if (meta.implicit_next_dt_s > 0)
-      sim->restore_implicit_state({meta.implicit_next_dt_s, meta.implicit_accepted_in_a_row});
+    // the checkpoint's Snapshot: rod, fluid velocity, clock, implicit controller
+    sim->restore(io::snapshot_of(std::move(*checkpoint), sim->dt()));
     result.initial = meta.initial;
     result.resumed_from = result.checkpoint_step = meta.step;
     checkpoint.reset();  // the state lives in sim now; free the copy

@@ -191,7 +191,7 @@ std::string Run::State::progress_line(const sim::Observables& o) const {
   const double ms = ms_per_step();
   const std::int64_t end = sim->end_step();
   char buf[320];
-  if (c.rod_closed)
+  if (sim->all_closed())
     std::snprintf(buf, sizeof buf,
                   "step %lld/%lld  t = %.4f us  Wr = %+.4f  Lk = %+.4f  E_K = %.3e kT  "
                   "%.3f ms/step  ETA %s",
@@ -222,22 +222,18 @@ void Run::State::write_frame() {
 }
 
 void Run::State::write_checkpoint(StopReason reason) {
-  meta.step = sim->step_count();
-  meta.time_s = sim->time();
-  if (sim->implicit()) {
-    const auto st = sim->implicit_state();
-    meta.implicit_next_dt_s = st.next_dt;
-    meta.implicit_accepted_in_a_row = st.accepted_in_a_row;
-    sim->checkpoint_taken();  // the resumed run starts the same way (bitwise resume)
-  }
+  // the state a resume puts back (Simulation::snapshot; the velocity only if it is written:
+  // collective, gathered to rank 0 under MPI)
+  const sim::Snapshot state = sim->snapshot(writes());
+  io::record_state(meta, state);
+  sim->checkpoint_taken();  // the resumed run starts the same way (bitwise resume)
   meta.stop_reason = to_string(reason);
   meta.wall_s = wall_before + seconds_since(t0);
   result.checkpoint_step = meta.step;
   if (!writes()) return;
-  const auto u = sim->stepper().whole_velocity(gathered);
   on_root([&] {
     files->check_directory(meta.step);
-    io::write_checkpoint(dir.checkpoint(), meta, sim->rod(), sim->params().stepper.grid.n, u);
+    io::write_checkpoint(dir.checkpoint(), meta, state, sim->params().stepper.grid.n);
   });
 }
 
@@ -261,8 +257,8 @@ void Run::State::finish(const sim::Observables& o, const std::string& stop_reaso
     if (error.empty())
       io::write_file_atomic(dir.final_state(), io::final_state_csv(sim->rod(), sim->rod_ranges()));
     if (npy) io::write_velocity_npy(dir.velocity(), c.grid_n, u[0], u[1], u[2]);
-    io::write_file_atomic(dir.summary(),
-                          summary_json(user, r, meta, files->frames(), stop_reason, error));
+    io::write_file_atomic(dir.summary(), summary_json(user, sim->all_closed(), r, meta,
+                                                      files->frames(), stop_reason, error));
   });
 }
 
@@ -336,8 +332,11 @@ StopReason Run::State::test_stability(StopReason candidate) {
 
 void Run::State::check_link(const sim::Observables& o) {
   double drift = 0;
-  if (o.rods.empty()) {
-    if (!c.rod_closed) return;  // an open rod has no linking number to conserve
+  const bool one = sim->rods().size() == 1;
+  if (one) {
+    // (one rod: against the initial row's link, which a checkpoint keeps; a checkpoint keeps no
+    // per-rod initial links)
+    if (!sim->rods()[0].closed) return;  // an open rod has no linking number to conserve
     drift = std::abs(o.link - result.initial.link);
   } else {
     // several rods: each closed rod's own link (a passage between two rings changes neither)
@@ -365,9 +364,9 @@ void Run::State::check_link(const sim::Observables& o) {
                   "too small, or Δt too large); recorded in summary.json",
                   static_cast<long long>(o.step), o.link, o.link - result.initial.link,
                   result.initial.link, kLinkDriftWarning,
-                  o.rods.empty() ? "the rod has probably passed through itself"
-                                 : "a rod has probably passed through itself or another rod "
-                                   "(rods.csv: each rod's link and each pair's)");
+                  one ? "the rod has probably passed through itself"
+                      : "a rod has probably passed through itself or another rod "
+                        "(rods.csv: each rod's link and each pair's)");
     say(buf);
   }
 }
@@ -489,7 +488,7 @@ RunResult Run::State::loop(const std::function<int()>& pending, std::int64_t max
   }
 
   char buf[512];
-  if (c.rod_closed)
+  if (sim->all_closed())
     std::snprintf(buf, sizeof buf,
                   "ibrod: stopped (%s) after %lld steps, t = %.4f us, Wr = %.4f, Tw = %.4f, "
                   "Lk = %.4f; %.1f s wall, %.3f ms/step",

@@ -34,8 +34,9 @@ namespace ibrod::driver {
 /// that stale frames or checkpoints never mix with the new run.
 void prepare_output_dir(const io::RunDir& dir, bool overwrite, std::optional<DirLock>& lock);
 
-/// summary.json of a run that stopped (stop_reason) or failed (error non-empty).
-std::string summary_json(const config::Config& c, const RunResult& r,
+/// summary.json of a run that stopped (stop_reason) or failed (error non-empty); closed: every
+/// rod is closed (Simulation::all_closed: the link is defined).
+std::string summary_json(const config::Config& c, bool closed, const RunResult& r,
                          const io::CheckpointMeta& meta, std::int64_t frames,
                          const std::string& stop_reason, const std::string& error);
 
@@ -48,7 +49,6 @@ class RunFiles {
            std::int64_t resume_step, const std::string& config_text, Progress& progress,
            std::int64_t frame_step = -1)
       : dir_(dir),
-        ds_(c.rod_rise_A),
         ranges_(sim.rod_ranges()),
         vti_(c.output_fluid_vti),
         frames_on_(sim.params().output.frames > 0),
@@ -172,9 +172,7 @@ class RunFiles {
     check_directory(sim.step_count());
     const double t_us = sim.time() / 1e-6;
     h5_->write_frame(sim.step_count(), t_us, sim.rod());
-    rod_pvd_.add(sim.step_count(), t_us,
-                 ranges_.size() > 1 ? io::rod_vtp(sim.rod(), rod_ds_, ranges_)
-                                    : io::rod_vtp(sim.rod(), ds_, sim.params().stepper.rod.closed));
+    rod_pvd_.add(sim.step_count(), t_us, io::rod_vtp(sim.rod(), rod_ds_, ranges_));
     if (vti_) fluid_pvd_.add(sim.step_count(), t_us, io::fluid_vti(sim.params().stepper.grid, u));
   }
 
@@ -182,7 +180,6 @@ class RunFiles {
 
  private:
   io::RunDir dir_;
-  double ds_;
   std::vector<rod::RodRange> ranges_;
   std::vector<double> rod_ds_;  // each rod's Δs, Å
   bool vti_, frames_on_;

@@ -4,11 +4,18 @@
 
 namespace ibrod::integrate {
 
-bool BlockCyclicCholesky::factorize(const std::vector<Mat6>& diag, const std::vector<Mat6>& lower) {
+bool BlockCyclicCholesky::factorize(const std::vector<Mat6>& diag, const std::vector<Mat6>& lower,
+                                    bool cyclic) {
   const int n = int(diag.size());
+  n_ = 0;
+  cyclic_ = cyclic;
+  if (!cyclic) {
+    if (n < 1 || lower.size() != diag.size())
+      throw std::invalid_argument("BlockCyclicCholesky: need n >= 1 diagonal and n lower blocks");
+    return factorize_tridiagonal(diag, lower);
+  }
   if (n < 3 || lower.size() != diag.size())
     throw std::invalid_argument("BlockCyclicCholesky: need n >= 3 diagonal and n lower blocks");
-  n_ = 0;
   L_.resize(n - 1);
   sub_.resize(n - 2);
   W_.resize(n - 1);
@@ -40,8 +47,12 @@ bool BlockCyclicCholesky::factorize(const std::vector<Mat6>& diag, const std::ve
   return true;
 }
 
-void BlockCyclicCholesky::solve(Eigen::VectorXd& x) const {
+void BlockCyclicCholesky::solve(Eigen::Ref<Eigen::VectorXd> x) const {
   if (n_ == 0) throw std::logic_error("BlockCyclicCholesky::solve: no factor");
+  if (!cyclic_) {
+    solve_tridiagonal(x);
+    return;
+  }
   const int n = n_;
   using Vec6 = Eigen::Matrix<double, 6, 1>;
   // L y = b
@@ -62,6 +73,54 @@ void BlockCyclicCholesky::solve(Eigen::VectorXd& x) const {
     if (k + 1 <= n - 2) y.noalias() -= sub_[k].transpose() * x.segment<6>(6 * (k + 1));
     y.noalias() -= W_[k].transpose() * acc;
     L_[k].triangularView<Eigen::Lower>().transpose().solveInPlace(y);
+    x.segment<6>(6 * k) = y;
+  }
+}
+
+// An open rod: S block-tridiagonal, L lower block-bidiagonal (pivots L_[k], k = 0 … n−1 with
+// L_[n−1] in last_, and sub_[k] = L[k+1][k]).
+bool BlockCyclicCholesky::factorize_tridiagonal(const std::vector<Mat6>& diag,
+                                                const std::vector<Mat6>& lower) {
+  const int n = int(diag.size());
+  L_.resize(n - 1);
+  sub_.resize(n - 1);
+  W_.clear();
+  Mat6 A = diag[0];
+  for (int k = 0; k < n; ++k) {
+    if (k > 0) {
+      A = diag[k];
+      A.noalias() -= sub_[k - 1] * sub_[k - 1].transpose();
+    }
+    Eigen::LLT<Mat6> llt(A);
+    if (llt.info() != Eigen::Success) return false;
+    if (k == n - 1) {
+      last_ = llt.matrixL();
+      break;
+    }
+    L_[k] = llt.matrixL();
+    // L[k+1][k] L_kᵀ = S[k+1][k]  ⇔  L_k L[k+1][k]ᵀ = S[k+1][k]ᵀ
+    sub_[k] = L_[k].triangularView<Eigen::Lower>().solve(lower[k].transpose()).transpose();
+  }
+  n_ = n;
+  return true;
+}
+
+void BlockCyclicCholesky::solve_tridiagonal(Eigen::Ref<Eigen::VectorXd> x) const {
+  const int n = n_;
+  using Vec6 = Eigen::Matrix<double, 6, 1>;
+  auto pivot = [&](int k) -> const Mat6& { return k == n - 1 ? last_ : L_[k]; };
+  // L y = b
+  for (int k = 0; k < n; ++k) {
+    Vec6 b = x.segment<6>(6 * k);
+    if (k > 0) b.noalias() -= sub_[k - 1] * x.segment<6>(6 * (k - 1));
+    pivot(k).triangularView<Eigen::Lower>().solveInPlace(b);
+    x.segment<6>(6 * k) = b;
+  }
+  // Lᵀ x = y
+  for (int k = n - 1; k >= 0; --k) {
+    Vec6 y = x.segment<6>(6 * k);
+    if (k < n - 1) y.noalias() -= sub_[k].transpose() * x.segment<6>(6 * (k + 1));
+    pivot(k).triangularView<Eigen::Lower>().transpose().solveInPlace(y);
     x.segment<6>(6 * k) = y;
   }
 }

@@ -36,7 +36,11 @@ void unpack(const VectorXd& v, std::span<Vec3> a, std::span<Vec3> b) {
 }  // namespace
 
 ImplicitStepper::ImplicitStepper(Stepper& stepper, const ImplicitParams& p)
-    : st_(stepper), p_(p), n_(stepper.params().rod.n) {
+    : st_(stepper),
+      p_(p),
+      rods_(all_rods(stepper.params())),
+      ranges_(rod::ranges_of(rods_)),
+      n_(point_count(stepper.params())) {
   if (st_.params().distributed)
     throw std::invalid_argument("ImplicitStepper: the fluid must not be distributed");
   if (!(p_.mobility_scale >= 0)) throw std::invalid_argument("ImplicitStepper: mobility_scale < 0");
@@ -47,8 +51,8 @@ ImplicitStepper::ImplicitStepper(Stepper& stepper, const ImplicitParams& p)
   if (p_.order == 2 && (p_.krylov_max_iter > 0 || !p_.velocity_form || !(p_.mobility_scale > 0)))
     throw std::invalid_argument(
         "ImplicitStepper: order 2 needs the velocity form, mobility_scale > 0 and no GMRES");
-  work_.resize(n_);
-  for (auto* v : {&U_, &W_, &Fa_, &Ta_, &Fb_, &Tb_}) v->assign(n_, Vec3::Zero());
+  for (auto* v : {&U_, &W_}) v->assign(n_, Vec3::Zero());
+  bcc_.resize(rods_.size());
 
   // Self mobilities of one kernel-spread point: a unit force (torque) at a generic position
   // of the grid, the velocity (angular velocity) interpolated at the same point.
@@ -87,7 +91,6 @@ bool same_state(const rod::RodState& a, const rod::RodState& b) {
   return a.X.size() == b.X.size() && std::equal(a.X.begin(), a.X.end(), b.X.begin()) &&
          std::equal(a.D.begin(), a.D.end(), b.D.begin());
 }
-double potential(const StepEnergies& e) { return e.elastic.total() + e.electro + e.steric; }
 }  // namespace
 
 namespace {
@@ -168,20 +171,24 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
   const bool local = p_.mobility_scale > 0;
   const Cached& c0 = forces_at(s);
   last_ = c0.E;
-  info.energy_before = potential(c0.E);
+  info.energy_before = c0.E.potential();
   VectorXd b;
   pack(c0.F, c0.T, b);
 
   if (local || p_.krylov_max_iter > 0) {
     if (steps_since_jacobian_ == 0 || !have_K_) {
       const double t0 = now();
-      // the fast path: no contacts, the local system is block-cyclic-tridiagonal
+      // the fast path: no contacts, the local system is block-diagonal over the rods, each
+      // block block-cyclic-tridiagonal (closed) or block-tridiagonal (open)
       use_blocks_ = false;
+      const bool bands = std::all_of(ranges_.begin(), ranges_.end(), [](const rod::RodRange& g) {
+        return g.n >= (g.closed ? 3 : 1);
+      });
       const bool overlap = p_.local_mobility == ImplicitParams::LocalMobility::overlap;
       if (p_.block_solver && local && !overlap && p_.gauss_newton && !p_.stiffness_fd &&
-          p_.krylov_max_iter == 0 && n >= 3 &&
+          p_.krylov_max_iter == 0 && bands &&
           (!p_.steric_implicit ||
-           detail::add_steric_stiffness(st_.params().steric, s.X, nullptr) == 0)) {
+           detail::add_steric_stiffness(st_.steric().params(), s.X, nullptr) == 0)) {
         gn_blocks(s);
         contacts_ = 0;
         use_blocks_ = true;
@@ -191,11 +198,12 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
       if (overlap && local) {
         // M_loc = β D O D at qⁿ
         const double t1 = now();
-        const double reach =
-            4 * st_.params().kernel_width * st_.params().grid.h() / st_.params().rod.ds;
-        const double window = std::min(p_.overlap_window * reach, 0.5 * n);
+        // the taper along the rod (off by default) for one rod only
+        const bool taper = p_.overlap_window > 0 && ranges_.size() == 1;
+        const double reach = 4 * st_.params().kernel_width * st_.params().grid.h() / rods_[0].ds;
+        const double window = taper ? std::min(p_.overlap_window * reach, 0.5 * n) : 0.0;
         Mov_ = kernel_overlap(s.X, st_.params().grid, st_.params().kernel_width, window,
-                              st_.params().rod.closed);
+                              ranges_[0].closed);
         auto d = [&](Eigen::Index i) { return i % 6 < 3 ? ov_t_ : ov_r_; };
         for (Eigen::Index c = 0; c < Mov_.outerSize(); ++c)
           for (Eigen::SparseMatrix<double>::InnerIterator it(Mov_, c); it; ++it)
@@ -322,7 +330,7 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
   info.finite = std::isfinite(info.max_displacement) && std::isfinite(info.max_rotation);
   if (info.finite) {
     try {
-      info.energy_after = potential(forces_at(s).E);
+      info.energy_after = forces_at(s).E.potential();
     } catch (const std::exception&) {  // a position out of any range: not finite
       info.finite = false;
     }

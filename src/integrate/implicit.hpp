@@ -72,7 +72,8 @@ struct ImplicitParams {
   LocalMobility local_mobility = LocalMobility::self;
   /// overlap: the taper along the rod, in reaches of the kernel along it (4c/Δs points; the
   /// window is clamped to half the ring): pairs farther apart along the rod than this are left
-  /// out of M_loc, so that close strands of a supercoil do not fill the LU (0: no taper)
+  /// out of M_loc, so that close strands of a supercoil do not fill the LU (0: no taper, the
+  /// default: at 3 reaches the 64³ path runs ahead, docs/large_dt.md; one rod only)
   double overlap_window = 0.0;
   double fd_dx = 1e-4;      ///< finite-difference step of K in positions, Å
   double fd_dtheta = 1e-5;  ///< ... and in rotation vectors, rad
@@ -106,7 +107,10 @@ class ImplicitStepper {
  public:
   /// Uses `stepper`'s serial fluid (not distributed), coupling and force modules; the fluid's
   /// velocity array becomes the Stokes velocity of the latest solve. Two Stokes solves here
-  /// measure the self mobilities.
+  /// measure the self mobilities. Any collection of rods (all_rods(stepper.params()): closed or
+  /// open, one or several, per-link moduli): the state is all their points, K and the local
+  /// system are block-diagonal over the rods (each rod's band on its own range, block-cyclic for
+  /// a closed rod, block-tridiagonal for an open one), the steric contacts couple any two.
   ImplicitStepper(Stepper& stepper, const ImplicitParams& p);
   ~ImplicitStepper();
 
@@ -126,7 +130,8 @@ class ImplicitStepper {
   void mobility(std::span<const Vec3> X, std::span<const Vec3> F, std::span<const Vec3> T,
                 std::span<Vec3> U, std::span<Vec3> W);
 
-  /// The elastic stiffness at s, [6n × 6n], per point (x, y, z, θx, θy, θz); units g s⁻²,
+  /// The elastic stiffness at s, [6n × 6n] over all rods' points, per point (x, y, z, θx, θy,
+  /// θz), each rod's blocks on its own range (no link past an open rod's ends); units g s⁻²,
   /// g Å s⁻², g Å² s⁻²: the Gauss–Newton K = Δs Σ_h J_hᵀ C J_h with the small-strain analytic
   /// strain Jacobian (default), or by central finite differences over a colouring of the rod
   /// (F_k, T_k depend on points k−1..k+1 only): Gauss–Newton (stiffness_fd) or the full
@@ -149,21 +154,28 @@ class ImplicitStepper {
  private:
   Stepper& st_;
   ImplicitParams p_;
-  int n_;
-  double m_t_ = 0, m_r_ = 0;  // self mobilities
-  double scale_t_ = 1;        // GMRES weight of torques: 1/ℓ, ℓ = √(m_t/m_r)
+  std::vector<rod::RodParams> rods_;   // every rod, in the state's order
+  std::vector<rod::RodRange> ranges_;  // where each lies in the state
+  int n_;                              // points of all rods
+  double m_t_ = 0, m_r_ = 0;           // self mobilities
+  double scale_t_ = 1;                 // GMRES weight of torques: 1/ℓ, ℓ = √(m_t/m_r)
   Eigen::SparseMatrix<double> K_;
-  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu_;          // full K (not symmetric)
-  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> llt_;    // Gauss–Newton K
-  Eigen::VectorXd mloc_;                                     // diagonal of M_loc (self)
-  Eigen::SparseMatrix<double> Mov_;                          // M_loc (overlap)
-  double ov_t_ = 1, ov_r_ = 1;                               // D's √c_t, √c_r (overlap)
-  std::vector<int> lu_outer_, lu_inner_;                     // the pattern lu_ analysed
-  std::vector<Eigen::Matrix<double, 6, 6>> Kd_, Ko_;         // GN K blocks: K[k][k], K[k+1][k]
-  BlockCyclicCholesky bcc_;                                  // their local system, no contacts
+  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu_;        // full K (not symmetric)
+  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> llt_;  // Gauss–Newton K
+  Eigen::VectorXd mloc_;                                   // diagonal of M_loc
+  // GN K blocks over all points: K[k][k], K[k+1][k] (k+1 within k's rod, cyclic if closed;
+  // zero at an open rod's last point)
+  std::vector<Eigen::Matrix<double, 6, 6>> Kd_, Ko_;
+  std::vector<BlockCyclicCholesky> bcc_;  // each rod's local system (no contacts)
+  Eigen::SparseMatrix<double> Mov_;       // M_loc (overlap)
+  double ov_t_ = 1, ov_r_ = 1;            // D's √c_t, √c_r (overlap)
+  std::vector<int> lu_outer_, lu_inner_;  // the pattern lu_ analysed (overlap)
   std::vector<Eigen::Matrix<double, 6, 6>> sdiag_, slower_;  // its blocks (scratch)
   bool use_blocks_ = false, have_K_ = false;
-  void gn_blocks(const rod::RodState& s);                       // fills Kd_, Ko_
+  void gn_blocks(const rod::RodState& s);  // fills Kd_, Ko_
+  // the finite-difference K of rod r (stiffness_fd or gauss_newton = false) into trip
+  void fd_stiffness(const rod::RodState& s, std::size_t r,
+                    std::vector<Eigen::Triplet<double>>& trip);
   Eigen::VectorXd local_solve(const Eigen::VectorXd& v) const;  // (I + Δt M_loc K)⁻¹ v
   bool pattern_ready_ = false;
   Eigen::Index pattern_nnz_ = 0;
@@ -172,8 +184,8 @@ class ImplicitStepper {
   long steps_since_jacobian_ = 0;
   StepEnergies last_;
   ImplicitTimings timings_;
-  rod::RodWork work_;
-  std::vector<Vec3> U_, W_, Fa_, Ta_, Fb_, Tb_;
+  rod::RodWork work_;                            // one rod's (finite-difference K)
+  std::vector<Vec3> U_, W_, Fa_, Ta_, Fb_, Tb_;  // U_, W_: all points; the others one rod's
   rod::RodState pert_, stage_;
   // forces at the state `cur_` (valid if has_cur_), and at the state before the latest step
   struct Cached {
@@ -231,7 +243,9 @@ class ImplicitIntegrator {
 
 namespace detail {
 /// The steric contacts' stiffness −∂F_steric/∂X as triplets of the 6n × 6n system (implicit_
-/// stiffness.cpp); trip = nullptr: count the contacts only. Returns the number of contacts.
+/// stiffness.cpp) over the segments interactions::Steric sees (p.rods: every rod's own, closed
+/// or open; empty: one rod of all points with p.closed); trip = nullptr: count the contacts
+/// only. Returns the number of contacts.
 int add_steric_stiffness(const interactions::StericParams& p, std::span<const Vec3> X,
                          std::vector<Eigen::Triplet<double>>* trip);
 }  // namespace detail

@@ -17,14 +17,15 @@ namespace {
 
 using Eigen::VectorXd;
 
-// Colours of a closed rod of n points such that two points of one colour are at least 3 apart
-// along the rod (cyclically): perturbing all of them at once changes each F_k, T_k through one
-// of them at most. Greedy: ≤ 5 colours, 3 when n is a multiple of 3.
-std::vector<int> colouring(int n) {
+// Colours of a rod of n points such that two points of one colour are at least 3 apart along
+// the rod (cyclically if closed): perturbing all of them at once changes each F_k, T_k through
+// one of them at most. Greedy: ≤ 5 colours, 3 when n is a multiple of 3 or the rod is open.
+std::vector<int> colouring(int n, bool closed) {
   std::vector<int> c(n, -1);
   for (int k = 0; k < n; ++k) {
     bool used[8] = {};
     for (int o = -2; o <= 2; ++o) {
+      if (!closed && (k + o < 0 || k + o >= n)) continue;
       const int j = ((k + o) % n + n) % n;
       if (o != 0 && c[j] >= 0) used[c[j]] = true;
     }
@@ -59,11 +60,33 @@ int add_steric_stiffness(const interactions::StericParams& p, std::span<const Ve
                          std::vector<Eigen::Triplet<double>>* trip) {
   const int n = int(X.size());
   if (!p.enabled || n < 4 || !(p.diameter > 0) || !(p.stiffness > 0)) return 0;
-  std::vector<Vec3> mid(n);
+  // the segments [X_a, X_b] as interactions::Steric lists them: each rod's own, in order
+  std::vector<rod::RodRange> chains = p.rods;
+  if (chains.empty()) chains.push_back({0, n, p.closed, p.ds});
+  std::vector<int> seg_a, seg_b, seg_chain, seg_pos;
+  for (std::size_t r = 0; r < chains.size(); ++r) {
+    const rod::RodRange& c = chains[r];
+    if (c.n < 2) continue;
+    for (int k = 0; k < rod::half_points(c.n, c.closed); ++k) {
+      seg_a.push_back(c.offset + k);
+      seg_b.push_back(c.offset + (k + 1) % c.n);
+      seg_chain.push_back(int(r));
+      seg_pos.push_back(k);
+    }
+  }
+  const int ns = int(seg_a.size());
+  // more than 2D apart along the rod (MODEL (2.17)), as Steric; segments of two rods always
+  auto far_along_rod = [&](int k, int l) {
+    if (seg_chain[k] != seg_chain[l]) return true;
+    const rod::RodRange& c = chains[std::size_t(seg_chain[k])];
+    const int m = std::abs(seg_pos[k] - seg_pos[l]);
+    return (c.closed ? std::min(m, c.n - m) : m) * c.ds > 2 * p.diameter;
+  };
+  std::vector<Vec3> mid(ns);
   double lmax2 = 0;
-  for (int k = 0; k < n; ++k) {
-    mid[k] = 0.5 * (X[k] + X[(k + 1) % n]);
-    lmax2 = std::max(lmax2, (X[(k + 1) % n] - X[k]).squaredNorm());
+  for (int k = 0; k < ns; ++k) {
+    mid[k] = 0.5 * (X[seg_a[k]] + X[seg_b[k]]);
+    lmax2 = std::max(lmax2, (X[seg_b[k]] - X[seg_a[k]]).squaredNorm());
   }
   const double reach = p.diameter + std::sqrt(lmax2);
   // candidates from a grid of cells of edge `reach` over the midpoints (sorted by cell key):
@@ -72,13 +95,13 @@ int add_steric_stiffness(const interactions::StericParams& p, std::span<const Ve
   auto key = [](std::int64_t i, std::int64_t j, std::int64_t k) {
     return ((i & 0x1FFFFF) << 42) | ((j & 0x1FFFFF) << 21) | (k & 0x1FFFFF);
   };
-  std::vector<std::pair<std::int64_t, int>> sorted(n);
-  for (int k = 0; k < n; ++k)
+  std::vector<std::pair<std::int64_t, int>> sorted(ns);
+  for (int k = 0; k < ns; ++k)
     sorted[k] = {key(cell(mid[k], 0), cell(mid[k], 1), cell(mid[k], 2)), k};
   std::sort(sorted.begin(), sorted.end());
   int contacts = 0;
   std::vector<int> partners;
-  for (int k = 0; k < n; ++k) {
+  for (int k = 0; k < ns; ++k) {
     partners.clear();
     const std::int64_t ci = cell(mid[k], 0), cj = cell(mid[k], 1), ck = cell(mid[k], 2);
     for (std::int64_t di = -1; di <= 1; ++di)
@@ -87,22 +110,21 @@ int add_steric_stiffness(const interactions::StericParams& p, std::span<const Ve
           const std::int64_t q = key(ci + di, cj + dj, ck + dk);
           auto it = std::lower_bound(sorted.begin(), sorted.end(), std::make_pair(q, -1));
           for (; it != sorted.end() && it->first == q; ++it) {
-            const int l = it->second, m = l - k;
-            // more than 2D apart along the rod (MODEL (2.17)), as Steric
-            if (l > k && std::min(m, n - m) * p.ds > 2 * p.diameter) partners.push_back(l);
+            const int l = it->second;
+            if (l > k && far_along_rod(k, l)) partners.push_back(l);
           }
         }
     std::sort(partners.begin(), partners.end());
     for (const int l : partners) {
       if ((mid[k] - mid[l]).squaredNorm() >= reach * reach) continue;
-      const int k1 = (k + 1) % n, l1 = (l + 1) % n;
-      const auto c = interactions::closest_points(X[k], X[k1], X[l], X[l1]);
+      const int k0 = seg_a[k], k1 = seg_b[k], l0 = seg_a[l], l1 = seg_b[l];
+      const auto c = interactions::closest_points(X[k0], X[k1], X[l0], X[l1]);
       if (!(c.d < p.diameter) || !(c.d > 0)) continue;
       ++contacts;
       if (!trip) continue;
       const Vec3 u = c.sep / c.d;
       const Mat3 uu = p.stiffness * u * u.transpose();
-      const int idx[4] = {k, k1, l, l1};
+      const int idx[4] = {k0, k1, l0, l1};
       const double w[4] = {1 - c.s, c.s, -(1 - c.t), -c.t};
       for (int a = 0; a < 4; ++a)
         for (int b = 0; b < 4; ++b)
@@ -123,67 +145,95 @@ void ImplicitStepper::gn_blocks(const rod::RodState& s) {
   //   δΩ_i = D^i·(δθ_{k+1} − δθ_k)/Δs
   // (a common rotation leaves Γ unchanged; the half-point triad turns by the mean of its two
   // ends'). K = Δs Σ_h J_hᵀ C_h J_h, C_h = diag(b1, b2, b3, a1, a2, a3) of link h (per link with
-  // rod.moduli_file): symmetric positive
-  // semi-definite, O(n), block-cyclic-tridiagonal: Kd_[k] = K[k][k], Ko_[k] = K[k+1][k].
+  // rod.moduli_file): symmetric positive semi-definite, O(n). Each rod on its own range with its
+  // own Δs and moduli, over its links (an open rod has no link from its last point to its
+  // first): block-cyclic-tridiagonal per closed rod, block-tridiagonal per open one:
+  // Kd_[k] = K[k][k], Ko_[k] = K[k+1][k].
   // tests/unit/integrate/test_implicit_parts.cpp compares it with the finite-difference K.
-  const int n = s.size();
-  const rod::RodParams& rp = st_.params().rod;
   using Mat6 = Eigen::Matrix<double, 6, 6>;
-  Kd_.assign(n, Mat6::Zero());
-  Ko_.assign(n, Mat6::Zero());
-  for (int h = 0; h < n; ++h) {
-    const int h1 = (h + 1) % n;
-    const Eigen::Matrix<double, 6, 1> c = moduli(rp, h);
-    const Mat3 Dh = rod::half_point_triad(s.D[h], s.D[h1]);
-    const Vec3 xp = (s.X[h1] - s.X[h]) / rp.ds;
-    Mat3 G;  // rows (D^i × X′)ᵀ
-    for (int i = 0; i < 3; ++i) G.row(i) = Dh.col(i).cross(xp).transpose();
-    Mat6 JL = Mat6::Zero(), JR = Mat6::Zero();  // ∂(Γ, Ω)/∂q_h, ∂(Γ, Ω)/∂q_{h+1}
-    JL.block<3, 3>(0, 0) = -Dh.transpose() / rp.ds;
-    JR.block<3, 3>(0, 0) = Dh.transpose() / rp.ds;
-    JL.block<3, 3>(0, 3) = 0.5 * G;
-    JR.block<3, 3>(0, 3) = 0.5 * G;
-    JL.block<3, 3>(3, 3) = -Dh.transpose() / rp.ds;
-    JR.block<3, 3>(3, 3) = Dh.transpose() / rp.ds;
-    const Mat6 CL = rp.ds * c.asDiagonal() * JL, CR = rp.ds * c.asDiagonal() * JR;
-    Kd_[h].noalias() += JL.transpose() * CL;
-    Kd_[h1].noalias() += JR.transpose() * CR;
-    Ko_[h].noalias() = JR.transpose() * CL;  // K[h+1][h]
+  Kd_.assign(n_, Mat6::Zero());
+  Ko_.assign(n_, Mat6::Zero());
+  for (std::size_t r = 0; r < rods_.size(); ++r) {
+    const rod::RodParams& rp = rods_[r];
+    const rod::RodRange& g = ranges_[r];
+    for (int h = 0; h < rod::half_points(g.n, g.closed); ++h) {
+      const int a = g.offset + h, b = g.offset + (h + 1) % g.n;
+      const Eigen::Matrix<double, 6, 1> c = moduli(rp, h);
+      const Mat3 Dh = rod::half_point_triad(s.D[a], s.D[b]);
+      const Vec3 xp = (s.X[b] - s.X[a]) / rp.ds;
+      Mat3 G;  // rows (D^i × X′)ᵀ
+      for (int i = 0; i < 3; ++i) G.row(i) = Dh.col(i).cross(xp).transpose();
+      Mat6 JL = Mat6::Zero(), JR = Mat6::Zero();  // ∂(Γ, Ω)/∂q_h, ∂(Γ, Ω)/∂q_{h+1}
+      JL.block<3, 3>(0, 0) = -Dh.transpose() / rp.ds;
+      JR.block<3, 3>(0, 0) = Dh.transpose() / rp.ds;
+      JL.block<3, 3>(0, 3) = 0.5 * G;
+      JR.block<3, 3>(0, 3) = 0.5 * G;
+      JL.block<3, 3>(3, 3) = -Dh.transpose() / rp.ds;
+      JR.block<3, 3>(3, 3) = Dh.transpose() / rp.ds;
+      const Mat6 CL = rp.ds * c.asDiagonal() * JL, CR = rp.ds * c.asDiagonal() * JR;
+      Kd_[a].noalias() += JL.transpose() * CL;
+      Kd_[b].noalias() += JR.transpose() * CR;
+      Ko_[a].noalias() = JR.transpose() * CL;  // K[h+1][h]
+    }
   }
 }
 
 Eigen::SparseMatrix<double> ImplicitStepper::stiffness(const rod::RodState& s) {
-  const int n = s.size();
-  const rod::RodParams& rp = st_.params().rod;
+  if (s.size() != n_)
+    throw std::invalid_argument("ImplicitStepper: the state has " + std::to_string(s.size()) +
+                                " points, the rods " + std::to_string(n_));
+  std::vector<Eigen::Triplet<double>> trip;
+  trip.reserve(std::size_t(n_) * 3 * 36 + 4096);
   if (p_.gauss_newton && !p_.stiffness_fd) {
     gn_blocks(s);
-    std::vector<Eigen::Triplet<double>> trip;
-    trip.reserve(std::size_t(n) * 3 * 36 + 4096);
-    for (int h = 0; h < n; ++h) {
-      const int h1 = (h + 1) % n;
-      for (int r = 0; r < 6; ++r)
-        for (int q = 0; q < 6; ++q) {
-          trip.emplace_back(6 * h + r, 6 * h + q, Kd_[h](r, q));
-          trip.emplace_back(6 * h1 + r, 6 * h + q, Ko_[h](r, q));
-          trip.emplace_back(6 * h + r, 6 * h1 + q, Ko_[h](q, r));
-        }
+    for (const rod::RodRange& g : ranges_) {
+      const int links = rod::half_points(g.n, g.closed);
+      for (int h = 0; h < g.n; ++h) {
+        const int a = g.offset + h, b = g.offset + (h + 1) % g.n;
+        for (int r = 0; r < 6; ++r)
+          for (int q = 0; q < 6; ++q) {
+            trip.emplace_back(6 * a + r, 6 * a + q, Kd_[a](r, q));
+            if (h >= links) continue;
+            trip.emplace_back(6 * b + r, 6 * a + q, Ko_[a](r, q));
+            trip.emplace_back(6 * a + r, 6 * b + q, Ko_[a](q, r));
+          }
+      }
     }
-    contacts_ =
-        p_.steric_implicit ? detail::add_steric_stiffness(st_.params().steric, s.X, &trip) : 0;
-    Eigen::SparseMatrix<double> K(6 * n, 6 * n);
-    K.setFromTriplets(trip.begin(), trip.end());
-    K.makeCompressed();
-    return K;
+  } else {
+    for (std::size_t r = 0; r < rods_.size(); ++r) fd_stiffness(s, r, trip);
   }
-  const std::vector<int> col = colouring(n);
-  const int ncol = *std::max_element(col.begin(), col.end()) + 1;
+  contacts_ =
+      p_.steric_implicit ? detail::add_steric_stiffness(st_.steric().params(), s.X, &trip) : 0;
+  Eigen::SparseMatrix<double> K(6 * n_, 6 * n_);
+  K.setFromTriplets(trip.begin(), trip.end());
+  K.makeCompressed();
+  return K;
+}
+
+void ImplicitStepper::fd_stiffness(const rod::RodState& all, std::size_t rod_index,
+                                   std::vector<Eigen::Triplet<double>>& trip) {
+  // rod r alone, on a copy of its range: its elastic loads depend on its own points only
+  const rod::RodParams& rp = rods_[rod_index];
+  const rod::RodRange& g = ranges_[rod_index];
+  const int n = g.n, off = g.offset;
+  const bool closed = g.closed;
+  const int links = rod::half_points(n, closed);
+  rod::RodState s;
+  rod::extract(all, g, s);
   pert_ = s;
-  std::vector<Eigen::Triplet<double>> trip;
-  trip.reserve(std::size_t(n) * 3 * 36 + 4096);
-  using Mat6 = Eigen::Matrix<double, 6, 6>;
+  work_.resize(n);
+  for (auto* v : {&Fa_, &Ta_, &Fb_, &Tb_}) v->assign(n, Vec3::Zero());
+  const std::vector<int> col = colouring(n, closed);
+  const int ncol = *std::max_element(col.begin(), col.end()) + 1;
+  // the neighbour of point j at offset o along the rod (−1: past an open rod's end)
+  auto along = [&](int j, int o) {
+    if (!closed && (j + o < 0 || j + o >= n)) return -1;
+    return ((j + o) % n + n) % n;
+  };
   using Vec6 = Eigen::Matrix<double, 6, 1>;
   // Gauss–Newton: the stress resultants of half point h, σ_h = (D_hᵀF_h, D_hᵀN_h) = C (ε_h − ε₀),
   // and their derivatives S_L = ∂σ_h/∂q_h, S_R = ∂σ_h/∂q_{h+1} by the same differences
+  using Mat6 = Eigen::Matrix<double, 6, 6>;
   std::vector<Mat6> SL, SR;
   std::vector<Vec6> sp, sm;
   if (p_.gauss_newton) {
@@ -205,9 +255,9 @@ Eigen::SparseMatrix<double> ImplicitStepper::stiffness(const rod::RodState& s) {
     if (p_.gauss_newton)
       for (int j = 0; j < n; ++j)
         if (col[j] == c) {
-          const int jm = (j + n - 1) % n;
-          sig[j] = sigma(j);
-          sig[jm] = sigma(jm);
+          const int jm = along(j, -1);
+          if (j < links) sig[j] = sigma(j);
+          if (jm >= 0) sig[jm] = sigma(jm);
         }
   };
   for (int c = 0; c < ncol; ++c) {
@@ -232,16 +282,19 @@ Eigen::SparseMatrix<double> ImplicitStepper::stiffness(const rod::RodState& s) {
         pert_.X[j] = s.X[j];
         pert_.D[j] = s.D[j];
         if (p_.gauss_newton) {
-          const int jm = (j + n - 1) % n;
-          SL[j].col(d) = (sp[j] - sm[j]) / (2 * eps);
-          SR[jm].col(d) = (sp[jm] - sm[jm]) / (2 * eps);
+          const int jm = along(j, -1);
+          if (j < links) SL[j].col(d) = (sp[j] - sm[j]) / (2 * eps);
+          if (jm >= 0) SR[jm].col(d) = (sp[jm] - sm[jm]) / (2 * eps);
           continue;
         }
         for (int o = -1; o <= 1; ++o) {
-          const int i = ((j + o) % n + n) % n;
+          const int i = along(j, o);
+          if (i < 0) continue;
           for (int r = 0; r < 3; ++r) {
-            trip.emplace_back(6 * i + r, 6 * j + d, -(Fa_[i][r] - Fb_[i][r]) / (2 * eps));
-            trip.emplace_back(6 * i + 3 + r, 6 * j + d, -(Ta_[i][r] - Tb_[i][r]) / (2 * eps));
+            trip.emplace_back(6 * (off + i) + r, 6 * (off + j) + d,
+                              -(Fa_[i][r] - Fb_[i][r]) / (2 * eps));
+            trip.emplace_back(6 * (off + i) + 3 + r, 6 * (off + j) + d,
+                              -(Ta_[i][r] - Tb_[i][r]) / (2 * eps));
           }
         }
       }
@@ -249,10 +302,10 @@ Eigen::SparseMatrix<double> ImplicitStepper::stiffness(const rod::RodState& s) {
   }
   if (p_.gauss_newton) {
     // K = Δs Σ_h J_hᵀ C_h J_h = Δs Σ_h S_hᵀ C_h⁻¹ S_h over the points h, h+1 of each half point
-    for (int h = 0; h < n; ++h) {
+    for (int h = 0; h < links; ++h) {
       const int h1 = (h + 1) % n;
       const Vec6 cinv = moduli(rp, h).cwiseInverse();
-      const int idx[2] = {h, h1};
+      const int idx[2] = {off + h, off + h1};
       const Mat6* S[2] = {&SL[h], &SR[h]};
       for (int a = 0; a < 2; ++a)
         for (int b = 0; b < 2; ++b) {
@@ -263,12 +316,6 @@ Eigen::SparseMatrix<double> ImplicitStepper::stiffness(const rod::RodState& s) {
         }
     }
   }
-  contacts_ =
-      p_.steric_implicit ? detail::add_steric_stiffness(st_.params().steric, s.X, &trip) : 0;
-  Eigen::SparseMatrix<double> K(6 * n, 6 * n);
-  K.setFromTriplets(trip.begin(), trip.end());
-  K.makeCompressed();
-  return K;
 }
 
 void ImplicitStepper::factorize(double dt) {
@@ -307,17 +354,22 @@ void ImplicitStepper::factorize(double dt) {
     mloc_.segment<3>(6 * k + 3).setConstant(p_.mobility_scale * m_r_);
   }
   if (use_blocks_) {
+    // block-diagonal over the rods: each rod's band factorised on its own
     std::vector<Eigen::Matrix<double, 6, 6>>& diag = sdiag_;
     std::vector<Eigen::Matrix<double, 6, 6>>& lower = slower_;
-    diag.resize(n_);
-    lower.resize(n_);
-    for (int k = 0; k < n_; ++k) {
-      diag[k] = dt * Kd_[k];
-      for (int i = 0; i < 6; ++i) diag[k](i, i) += 1.0 / mloc_[6 * k + i];
-      lower[k] = dt * Ko_[k];
+    for (std::size_t r = 0; r < ranges_.size(); ++r) {
+      const rod::RodRange& g = ranges_[r];
+      diag.resize(g.n);
+      lower.resize(g.n);
+      for (int j = 0; j < g.n; ++j) {
+        const int k = g.offset + j;
+        diag[j] = dt * Kd_[k];
+        for (int i = 0; i < 6; ++i) diag[j](i, i) += 1.0 / mloc_[6 * k + i];
+        lower[j] = dt * Ko_[k];
+      }
+      if (!bcc_[r].factorize(diag, lower, g.closed))
+        throw std::runtime_error("ImplicitStepper: the local implicit system is not positive");
     }
-    if (!bcc_.factorize(diag, lower))
-      throw std::runtime_error("ImplicitStepper: the local implicit system is not positive");
     lu_dt_ = dt;
     return;
   }
@@ -363,7 +415,8 @@ void ImplicitStepper::factorize(double dt) {
 Eigen::VectorXd ImplicitStepper::local_solve(const Eigen::VectorXd& v) const {
   if (use_blocks_) {
     VectorXd x = p_.velocity_form ? VectorXd(v.cwiseQuotient(mloc_)) : v;
-    bcc_.solve(x);
+    for (std::size_t r = 0; r < ranges_.size(); ++r)
+      bcc_[r].solve(x.segment(6 * ranges_[r].offset, 6 * ranges_[r].n));
     return p_.velocity_form ? x : VectorXd(x.cwiseQuotient(mloc_));
   }
   if (!p_.gauss_newton || p_.local_mobility == ImplicitParams::LocalMobility::overlap)

@@ -36,15 +36,11 @@ ib::XSlab slab_of(const GridSpec& grid, const fluid::DistributedFluid* d) {
   return d ? ib::XSlab{d->x_begin(), d->x_count()} : ib::XSlab{0, grid.n};
 }
 
-// the hard core follows the rod: closed (cyclic segments) or open; with several rods, each its own
+// the hard core follows the rods: each its own segments, closed (cyclic) or open
 interactions::StericParams steric_of(const StepperParams& p) {
   interactions::StericParams s = p.steric;
   s.closed = p.rod.closed;
-  if (!p.more_rods.empty())
-    for (const rod::RodParams& r : all_rods(p)) {
-      const int offset = s.chains.empty() ? 0 : s.chains.back().offset + s.chains.back().n;
-      s.chains.push_back({offset, r.n, r.ds, r.closed});
-    }
+  s.rods = rod::ranges_of(all_rods(p));
   return s;
 }
 }  // namespace
@@ -164,6 +160,25 @@ void Stepper::add_external(const std::vector<Vec3>& X) {
 StepEnergies Stepper::compute_forces(const rod::RodState& s) {
   PhaseClock none(nullptr);
   return forces(s, none);
+}
+
+StepEnergies Stepper::energies(const rod::RodState& s) const {
+  StepEnergies e;
+  if (rods_.empty()) {
+    e.elastic = rod::elastic_energy(p_.rod, s);
+  } else {
+    rod::RodState one;
+    for (std::size_t r = 0; r < rods_.size(); ++r) {
+      rod::extract(s, ranges_[r], one);
+      const rod::ElasticEnergy er = rod::elastic_energy(rods_[r], one);
+      e.elastic.bend += er.bend;
+      e.elastic.twist += er.twist;
+      e.elastic.stretch += er.stretch;
+    }
+  }
+  if (p_.electro.enabled) e.electro = electro_.energy(s.X);
+  if (p_.steric.enabled) e.steric = steric_.energy(s.X);
+  return e;
 }
 
 rod::ElasticEnergy Stepper::elastic(const rod::RodState& s) {

@@ -66,11 +66,36 @@ std::vector<rod::RodParams> all_rods(const StepperParams& p);
 /// Points of all rods together (the size of the state and of every per-point buffer).
 int point_count(const StepperParams& p);
 
-/// Potential energies of the state whose forces compute_forces() evaluated, g Å² s⁻².
+/// The potential energy of a state by term, g Å² s⁻² (Stepper::compute_forces with the forces,
+/// Stepper::energies without). The one list of the terms (terms()) that every sum of the
+/// potential energy takes: the observables' E_total, Simulation::total_energy_kT and the implicit
+/// step's energy check. A new force adds its term here (ARCHITECTURE.md "How to add a force").
 struct StepEnergies {
   rod::ElasticEnergy elastic;
   double electro = 0;
   double steric = 0;
+  /// f(term) for each term, in the order every sum takes: bend, twist, stretch, electrostatic,
+  /// steric.
+  template <class F>
+  void terms(F&& f) const {
+    f(elastic.bend);
+    f(elastic.twist);
+    f(elastic.stretch);
+    f(electro);
+    f(steric);
+  }
+  /// Σ of the terms, g Å² s⁻²
+  double potential() const {
+    double e = 0;
+    terms([&](double t) { e += t; });
+    return e;
+  }
+  /// Σ of the terms each in kT (the time series' unit: the sum of its columns), kT in g Å² s⁻²
+  double potential_kT(double kT) const {
+    double e = 0;
+    terms([&](double t) { e += t / kT; });
+    return e;
+  }
 };
 
 /// The IB coupling as the fluid's plane-by-plane forcing and sampler (src/fluid knows nothing of
@@ -115,6 +140,9 @@ class Stepper {
 
   /// Rod forces only (step 1): fills the point forces and torques and returns the energies.
   StepEnergies compute_forces(const rod::RodState& s);
+  /// The energies of s without the forces (each term by its direct sum: the diagnostics' values,
+  /// O(n²) for the pair terms). Every term compute_forces() adds is here too.
+  StepEnergies energies(const rod::RodState& s) const;
 
   const StepperParams& params() const { return p_; }
   /// The counter of the fluid's thermal noise (fluid::FluidSolver::set_noise_step); the

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/types.hpp"
+#include "rod/rod_set.hpp"
 
 namespace ibrod::interactions {
 
@@ -158,30 +159,21 @@ SegmentContact closest_points(const Vec3& P0, const Vec3& P1, const Vec3& Q0, co
 double steric_pair(double D, double g, const Vec3& P0, const Vec3& P1, const Vec3& Q0,
                    const Vec3& Q1, std::array<Vec3, 4>& f);
 
-/// One rod of several in the point list (StericParams::chains): points offset … offset + n − 1,
-/// spacing ds (Å), closed or open.
-struct Chain {
-  int offset = 0;
-  int n = 0;
-  double ds = 3.4;
-  bool closed = true;
-};
-
 struct StericParams {
   bool enabled = true;
   double diameter = 20.0;  ///< D, Å
   double stiffness = 0.0;  ///< g, g s⁻² (force per Å of overlap)
   double ds = 3.4;         ///< Δs of the rod, Å (pairs closer than 2D along the rod are skipped)
   bool closed = true;  ///< closed rod (n segments, cyclic distance) or open (n − 1, |k − l|)
-  /// Several rods (`[[rods]]`): the rods' ranges of the point list, in order, covering it; the
-  /// segments are each rod's own (ds and closed from its Chain), and two segments of different
-  /// rods always count as a pair. Empty: one rod of all points with `ds` and `closed` above.
-  std::vector<Chain> chains;
+  /// The rods' layouts in the point list (rod::RodRange), in order, covering it; the segments
+  /// are each rod's own (its ds and closed), and two segments of different rods always count as
+  /// a pair. Empty: one rod of all points with `ds` and `closed` above.
+  std::vector<rod::RodRange> rods;
 };
 
 /// Hard-core repulsion between non-neighbouring segments [X_k, X_{k+1}] of the rod (closed: k =
 /// 0 … n−1, X_n = X_0; open, StericParams::closed = false: k = 0 … n−2), and with several rods
-/// (StericParams::chains) between every two segments of different rods as well:
+/// (StericParams::rods) between every two segments of different rods as well:
 /// for each pair of segments more than 2D apart along the rod whose closest points are at
 /// distance d < D, energy ½ g (D − d)² and the matching forces (−∂E/∂X) distributed to the
 /// segments' end points. Accumulates into F; returns the energy.
@@ -207,7 +199,7 @@ class Steric {
   /// the segments: end points a → b, rod (chain) and position along it; built for a point list
   /// of seg_built_for_ points (in the constructor, again only if a call brings another size)
   mutable std::vector<int> seg_a_, seg_b_, seg_chain_, seg_pos_;
-  mutable std::vector<Chain> chains_;
+  mutable std::vector<rod::RodRange> chains_;
   mutable int seg_built_for_ = -1;
   void build_segments(int n) const;
   bool far_along_rod(int k, int l) const;  ///< whether segments k, l form a pair

@@ -82,10 +82,10 @@ double steric_pair(double D, double g, const Vec3& P0, const Vec3& P1, const Vec
 
 void Steric::build_segments(int n) const {
   if (seg_built_for_ == n) return;
-  std::vector<Chain> chains = p_.chains;
-  if (chains.empty()) chains.push_back({0, n, p_.ds, p_.closed});
+  std::vector<rod::RodRange> chains = p_.rods;
+  if (chains.empty()) chains.push_back({0, n, p_.closed, p_.ds});
   int count = 0;
-  for (const Chain& c : chains) {
+  for (const rod::RodRange& c : chains) {
     if (c.offset != count || c.n < 0)
       throw std::invalid_argument("Steric: the rods' ranges must cover the points in order");
     count += c.n;
@@ -98,7 +98,7 @@ void Steric::build_segments(int n) const {
   seg_chain_.clear();
   seg_pos_.clear();
   for (std::size_t r = 0; r < chains.size(); ++r) {
-    const Chain& c = chains[r];
+    const rod::RodRange& c = chains[r];
     if (c.n < 2) continue;
     const int ns = c.closed ? c.n : c.n - 1;  // closed: the last one X_{n−1} → X_0
     for (int k = 0; k < ns; ++k) {
@@ -116,7 +116,7 @@ void Steric::build_segments(int n) const {
 // apart along it (closed: the cyclic index distance; open: |k − l|).
 bool Steric::far_along_rod(int k, int l) const {
   if (seg_chain_[k] != seg_chain_[l]) return true;
-  const Chain& c = chains_[seg_chain_[k]];
+  const rod::RodRange& c = chains_[seg_chain_[k]];
   const int m = std::abs(seg_pos_[k] - seg_pos_[l]);
   return (c.closed ? std::min(m, c.n - m) : m) * c.ds > 2 * p_.diameter;
 }

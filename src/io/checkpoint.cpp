@@ -5,6 +5,7 @@
 #include <cstring>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <stdexcept>
 
 #include "core/error.hpp"
 #include "core/text_file.hpp"
@@ -245,6 +246,33 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
   ck.velocity.resize(values);
   r.get(ck.velocity.data(), values * sizeof(double));
   return ck;
+}
+
+void write_checkpoint(const std::filesystem::path& path, const CheckpointMeta& meta,
+                      const sim::Snapshot& s, int grid_n) {
+  const std::size_t n3 = std::size_t(grid_n) * std::size_t(grid_n) * std::size_t(grid_n);
+  if (s.velocity.size() != 3 * n3)
+    throw std::invalid_argument("write_checkpoint: the snapshot holds no whole velocity");
+  const double* v = s.velocity.data();
+  write_checkpoint(path, meta, s.rod, grid_n, {v, v + n3, v + 2 * n3});
+}
+
+void record_state(CheckpointMeta& meta, const sim::Snapshot& s) {
+  meta.step = s.step;
+  meta.time_s = s.time;
+  meta.implicit_next_dt_s = s.implicit.next_dt > 0 ? s.implicit.next_dt : -1.0;
+  meta.implicit_accepted_in_a_row = s.implicit.next_dt > 0 ? s.implicit.accepted_in_a_row : 0;
+}
+
+sim::Snapshot snapshot_of(Checkpoint&& ck, double dt) {
+  sim::Snapshot s;
+  s.rod = std::move(ck.rod);
+  s.velocity = std::move(ck.velocity);
+  s.step = ck.meta.step;
+  // checkpoints from before time was state: step × Δt of the run that wrote them
+  s.time = ck.meta.time_s >= 0 ? ck.meta.time_s : double(ck.meta.step) * dt;
+  s.implicit = {ck.meta.implicit_next_dt_s, ck.meta.implicit_accepted_in_a_row};
+  return s;
 }
 
 }  // namespace ibrod::io

@@ -63,8 +63,21 @@ struct Checkpoint {
 void write_checkpoint(const std::filesystem::path& path, const CheckpointMeta& meta,
                       const rod::RodState& rod, int grid_n, std::array<const double*, 3> u);
 
+/// The same, of a Simulation's state: its rod and velocity (s.velocity, 3 grid_n³ values).
+void write_checkpoint(const std::filesystem::path& path, const CheckpointMeta& meta,
+                      const sim::Snapshot& s, int grid_n);
+
 /// Reads and verifies a checkpoint. Throws ConfigError naming the file and what is wrong.
 Checkpoint read_checkpoint(const std::filesystem::path& path);
+
+/// Records in meta what of a Snapshot the JSON keeps: the step, the simulated time and the
+/// implicit controller (next Δt ≤ 0: the explicit scheme's −1).
+void record_state(CheckpointMeta& meta, const sim::Snapshot& s);
+
+/// The Snapshot a checkpoint holds, for Simulation::restore: its rod and velocity (moved out of
+/// ck), step, time (step × dt for checkpoints from before time was state, time_s < 0) and
+/// implicit controller.
+sim::Snapshot snapshot_of(Checkpoint&& ck, double dt);
 
 /// CRC-32 (IEEE 802.3, reflected polynomial 0xEDB88320) of `bytes`, continuing from `crc`.
 std::uint32_t crc32(const void* data, std::size_t bytes, std::uint32_t crc = 0);

@@ -165,11 +165,15 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
   std::vector<float> arc(depth.size(), 0.0f);
   // the rods: one (X, style.closed), or several laid end to end (style.rods); each point's next
   // and previous point along its rod (−1 past a free end), its rod, and the rods' arc lengths
-  std::vector<std::pair<int, bool>> rods = style.rods;
-  if (rods.empty()) rods.push_back({int(n), style.closed});
+  std::vector<rod::RodRange> rods = style.rods;
+  if (rods.empty()) rods.push_back({0, int(n), style.closed});
   {
     std::size_t total = 0;
-    for (const auto& [m, c] : rods) total += std::size_t(m);
+    for (const rod::RodRange& g : rods) {
+      if (g.offset != int(total))
+        throw std::invalid_argument("render_rod: the rods are not laid end to end");
+      total += std::size_t(g.n);
+    }
     if (total != n) throw std::invalid_argument("render_rod: the rods' points are not X's");
   }
   std::vector<long> next(n, -1), prev(n, -1);
@@ -179,12 +183,12 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
   {
     std::size_t off = 0;
     for (std::size_t r = 0; r < rods.size(); ++r) {
-      const std::size_t m = std::size_t(rods[r].first);
-      rod_closed[r] = rods[r].second;
+      const std::size_t m = std::size_t(rods[r].n);
+      rod_closed[r] = rods[r].closed;
       for (std::size_t k = 0; k < m; ++k) {
         rod_of[off + k] = int(r);
-        if (k + 1 < m || rods[r].second) next[off + k] = long(off + (k + 1) % m);
-        if (k > 0 || rods[r].second) prev[off + k] = long(off + (k + m - 1) % m);
+        if (k + 1 < m || rods[r].closed) next[off + k] = long(off + (k + 1) % m);
+        if (k > 0 || rods[r].closed) prev[off + k] = long(off + (k + m - 1) % m);
       }
       off += m;
     }
@@ -207,8 +211,9 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
   if (style.colouring == Colouring::twist) {
     tw_point.resize(n);
     std::size_t off = 0;
-    for (const auto& [m_, closed_r] : rods) {
-      const std::size_t m = std::size_t(m_);
+    for (const rod::RodRange& g : rods) {
+      const std::size_t m = std::size_t(g.n);
+      const bool closed_r = g.closed;
       const auto tw = twist_density(X.subspan(off, m), d1.subspan(off, m));
       for (std::size_t k = 0; k < m; ++k) tw_point[off + k] = 0.5 * (tw[(k + m - 1) % m] + tw[k]);
       if (!closed_r) {  // the ends have one segment each

@@ -13,6 +13,7 @@
 
 #include "core/types.hpp"
 #include "render/image.hpp"
+#include "rod/rod_set.hpp"
 
 namespace ibrod::render {
 
@@ -67,9 +68,10 @@ struct Style {
   bool axis_triad = false;          ///< the lab axes x, y, z at the bottom right
   Rgb ink{40, 40, 40};              ///< labels, scale bar and axis triad
   bool closed = true;  ///< X is a closed polygon (a ring); false: open (no segment X_{n−1} → X_0)
-  /// Several rods: X holds these rods one after another, (points, closed) each; each is its own
-  /// tube (no segment joins two rods; `closed` above is then unused). Empty: X is one rod.
-  std::vector<std::pair<int, bool>> rods;
+  /// The rods' layouts (rod::RodRange: offset, points, closed), laid one after another in X; each
+  /// is its own tube (no segment joins two rods; `closed` above is then unused). Empty: X is one
+  /// rod, closed as `closed` says.
+  std::vector<rod::RodRange> rods;
 };
 
 /// Renders the tube of diameter `diameter` (X's length unit) about the closed polygon X (open

@@ -9,7 +9,7 @@ std::vector<RodRange> ranges_of(std::span<const RodParams> rods) {
   r.reserve(rods.size());
   int offset = 0;
   for (const RodParams& p : rods) {
-    r.push_back({offset, p.n, p.closed});
+    r.push_back({offset, p.n, p.closed, p.ds});
     offset += p.n;
   }
   return r;
@@ -23,6 +23,13 @@ void extract(const RodState& all, const RodRange& r, RodState& out) {
   for (int k = 0; k < r.n; ++k) {
     out.X[k] = all.X[r.offset + k];
     out.D[k] = all.D[r.offset + k];
+  }
+}
+
+void insert(RodState& all, const RodRange& r, const RodState& one) {
+  for (int k = 0; k < r.n; ++k) {
+    all.X[r.offset + k] = one.X[k];
+    all.D[r.offset + k] = one.D[k];
   }
 }
 

@@ -11,19 +11,26 @@
 
 namespace ibrod::rod {
 
-/// Where one rod's points lie in the whole state: points offset … offset + n − 1.
+/// The layout of one rod of a collection: where its points lie in the whole state (points
+/// offset … offset + n − 1), closed or open, and its spacing Δs (Å). The one layout type of the
+/// code: the stepper's and the implicit scheme's per-rod loops, the steric segments
+/// (interactions::StericParams::rods), the outputs and the pictures all take it.
 struct RodRange {
   int offset = 0;
   int n = 0;
   bool closed = true;
+  double ds = 3.4;  ///< Å
 };
 
-/// The ranges of rods laid end to end, in order.
+/// The ranges of rods laid end to end, in order (each rod's n, closed and Δs).
 std::vector<RodRange> ranges_of(std::span<const RodParams> rods);
 
 /// Copies rod r's positions and triads out of the whole state into `out` (resized only when its
 /// size differs, so a reused `out` allocates nothing).
 void extract(const RodState& all, const RodRange& r, RodState& out);
+
+/// Copies `one` (r.n points) back into rod r's range of the whole state.
+void insert(RodState& all, const RodRange& r, const RodState& one);
 
 /// Appends a rod's state to the whole state.
 void append(RodState& all, const RodState& one);

@@ -1,5 +1,6 @@
 #include "sim/simulation.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -68,17 +69,8 @@ SimParams checked(SimParams p) {
     if (p.more_circles.size() != p.stepper.more_rods.size() ||
         p.more_rotations.size() != p.stepper.more_rods.size())
       throw std::invalid_argument("Simulation: one initial shape per rod");
-    if (p.scheme == TimeScheme::implicit_step)
-      throw std::invalid_argument(
-          "Simulation: the implicit scheme runs one rod only (docs/model.md \"Several rods\")");
-    // docs/model.md "Several rods": the stability test's kick is a single rod's; a run of several
-    // rods stops at the kinetic-energy rule as it stands
-    p.stability.enabled = false;
   }
   if (p.scheme == TimeScheme::implicit_step) {
-    if (!p.stepper.rod.closed)
-      throw std::invalid_argument(
-          "Simulation: the implicit scheme needs a closed rod (its local solve is block-cyclic)");
     if (p.stepper.distributed)
       throw std::invalid_argument("Simulation: the implicit scheme runs on one process only");
     integrate::AdaptiveDtParams& a = p.adaptive;
@@ -157,6 +149,39 @@ std::string Simulation::start_problem() const {
 
 std::string Simulation::state_check() const { return rods_problem(rods_, rod_, tolerances_); }
 
+Snapshot Simulation::snapshot(bool with_velocity) const {
+  Snapshot s;
+  s.rod = rod_;
+  if (with_velocity) {
+    std::vector<double> scratch;
+    const auto u = stepper_.whole_velocity(scratch);  // collective when distributed
+    if (u[0]) {
+      const std::size_t n3 = p_.stepper.grid.size();
+      s.velocity.resize(3 * n3);
+      for (int c = 0; c < 3; ++c) std::copy_n(u[std::size_t(c)], n3, s.velocity.begin() + c * n3);
+    }
+  }
+  s.step = step_;
+  s.time = time_;
+  if (implicit_) s.implicit = implicit_->state();
+  return s;
+}
+
+void Simulation::restore(const Snapshot& s) {
+  rod_ = s.rod;
+  const std::size_t n3 = p_.stepper.grid.size();
+  if (s.velocity.size() != 3 * n3)
+    throw std::invalid_argument("Simulation::restore: a velocity of " +
+                                std::to_string(s.velocity.size()) + " values, the grid needs " +
+                                std::to_string(3 * n3));
+  const double* v = s.velocity.data();
+  stepper_.set_whole_velocity({v, v + n3, v + 2 * n3});
+  step_ = s.step;
+  time_ = s.time;
+  prev_time_ = s.time;
+  if (implicit_ && s.implicit.next_dt > 0) implicit_->restore(s.implicit);
+}
+
 void Simulation::set_rod_state(rod::RodState s, const std::string& what) {
   if (const std::string bad = rods_state_problem(rods_, s, p_.stepper.grid.L); !bad.empty())
     throw std::invalid_argument(what + ": " + bad);
@@ -210,23 +235,6 @@ void Simulation::step() {
 }
 
 namespace {
-// The elastic energy of every rod, summed (one rod: elastic_energy itself).
-rod::ElasticEnergy elastic_energy_of(const std::vector<rod::RodParams>& rods,
-                                     const std::vector<rod::RodRange>& ranges,
-                                     const rod::RodState& s) {
-  if (rods.size() == 1) return rod::elastic_energy(rods[0], s);
-  rod::ElasticEnergy e;
-  rod::RodState one;
-  for (std::size_t r = 0; r < rods.size(); ++r) {
-    rod::extract(s, ranges[r], one);
-    const rod::ElasticEnergy er = rod::elastic_energy(rods[r], one);
-    e.bend += er.bend;
-    e.twist += er.twist;
-    e.stretch += er.stretch;
-  }
-  return e;
-}
-
 struct Topology {
   double writhe, twist, link, closest, spacing;  // spacing: the mean, Å
   int links;
@@ -260,19 +268,15 @@ Observables Simulation::observe() {
   Observables o;
   o.step = step_;
   o.time_us = time() / 1e-6;
-  const auto el = elastic_energy_of(rods_, ranges_, rod_);
-  o.E_bend_kT = el.bend / kT;
-  o.E_twist_kT = el.twist / kT;
-  o.E_stretch_kT = el.stretch / kT;
-  if (p_.stepper.electro.enabled) {
-    const double e = stepper_.electrostatics().energy(rod_.X);
-    o.E_electro_kT = e / kT;
-    o.dE_electro_kT = (e - electro_circle_) / kT;
-  }
-  if (p_.stepper.steric.enabled) o.E_steric_kT = stepper_.steric().energy(rod_.X) / kT;
+  const integrate::StepEnergies E = stepper_.energies(rod_);
+  o.E_bend_kT = E.elastic.bend / kT;
+  o.E_twist_kT = E.elastic.twist / kT;
+  o.E_stretch_kT = E.elastic.stretch / kT;
+  o.E_electro_kT = E.electro / kT;
+  if (p_.stepper.electro.enabled) o.dE_electro_kT = (E.electro - electro_circle_) / kT;
+  o.E_steric_kT = E.steric / kT;
   o.E_kinetic_kT = stepper_.fluid_kinetic_energy() / kT;  // collective when distributed
-  o.E_total_kT =
-      o.E_bend_kT + o.E_twist_kT + o.E_stretch_kT + o.E_electro_kT + o.E_steric_kT + o.E_kinetic_kT;
+  o.E_total_kT = E.potential_kT(kT) + o.E_kinetic_kT;     // the one sum (StepEnergies::terms)
 
   if (rods_.size() == 1) {
     const Topology t = topology_of(rod_, rods_[0].closed, p_.closest_min_separation);
@@ -281,6 +285,7 @@ Observables Simulation::observe() {
     o.link = t.link;
     o.closest_approach_A = t.closest;
     o.bp_spacing_A = t.spacing;
+    o.rods.push_back({t.writhe, t.twist, t.link});  // a collection of one: its rod's are the totals
     return o;
   }
   // several rods: each rod's own, summed; the closest approach also over pairs of rods
@@ -317,12 +322,7 @@ Observables Simulation::observe() {
 
 double Simulation::total_energy_kT() {
   const double kT = p_.kT;
-  const auto el = elastic_energy_of(rods_, ranges_, rod_);
-  const double electro =
-      p_.stepper.electro.enabled ? stepper_.electrostatics().energy(rod_.X) / kT : 0.0;
-  const double steric = p_.stepper.steric.enabled ? stepper_.steric().energy(rod_.X) / kT : 0.0;
-  const double kinetic = stepper_.fluid_kinetic_energy() / kT;
-  return el.bend / kT + el.twist / kT + el.stretch / kT + electro + steric + kinetic;
+  return stepper_.energies(rod_).potential_kT(kT) + stepper_.fluid_kinetic_energy() / kT;
 }
 
 StopReason Simulation::stop_reason(const Observables& o) const {

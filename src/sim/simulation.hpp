@@ -74,10 +74,11 @@ struct Observables {
   double E_steric_kT = 0, E_kinetic_kT = 0, E_total_kT = 0;
   double writhe = 0, twist = 0, link = 0;
   double closest_approach_A = 0, bp_spacing_A = 0;
-  /// Several rods: each rod's writhe, twist and link (NaN where not defined: open rods); the
-  /// columns above then hold their sums (link and writhe NaN if any rod is open), the closest
-  /// approach over each rod's own pairs and every pair of points of different rods, the
-  /// spacing averaged over all links. Empty for one rod.
+  /// Each rod's writhe, twist and link, in the state's order (NaN where not defined: open rods);
+  /// the columns above hold their sums (link and writhe NaN if any rod is open; one rod: its
+  /// own values), the closest approach over each rod's own pairs and every pair of points of
+  /// different rods, the spacing averaged over all links. One rod: one entry, equal to the
+  /// columns above.
   struct PerRod {
     double writhe = 0, twist = 0, link = 0;
   };
@@ -86,6 +87,22 @@ struct Observables {
   /// (0,1), (0,2), …, (1,2), …; a topological invariant like each rod's link (a passage of one
   /// rod through another changes it). Empty for one rod.
   std::vector<double> pair_links;
+};
+
+/// The dynamical state of a trajectory, all that a Simulation of the same parameters needs to go
+/// on bitwise as the one it was taken from: what a checkpoint keeps (written and read back on
+/// resume) and what the stability test saves and puts back. Taken by Simulation::snapshot() and
+/// put back by Simulation::restore().
+struct Snapshot {
+  rod::RodState rod;  ///< every rod's points and triads (Simulation::rod())
+  /// the fluid velocity, [3 N³] Å/s: the u_x block, then u_y, then u_z (GridSpec::index);
+  /// empty when not taken (snapshot(false), or an MPI rank other than 0)
+  std::vector<double> velocity;
+  std::int64_t step = 0;
+  double time = 0;  ///< simulated time, s
+  /// time.scheme = "implicit": the step controller's next Δt and run of accepted steps;
+  /// next_dt ≤ 0 for the explicit scheme (none)
+  integrate::ImplicitIntegrator::State implicit{-1, 0};
 };
 
 /// Why a run stopped (summary.json's stop_reason, the checkpoint's): none while it runs.
@@ -113,6 +130,12 @@ class Simulation {
   const std::vector<rod::RodParams>& rods() const { return rods_; }
   /// Where each rod lies in rod() (rod::RodRange).
   const std::vector<rod::RodRange>& rod_ranges() const { return ranges_; }
+  /// Whether every rod is closed: the collection's link and writhe are defined (sums of each
+  /// rod's), so the progress lines and summary.json report them; else "not defined".
+  bool all_closed() const {
+    return std::all_of(rods_.begin(), rods_.end(),
+                       [](const rod::RodParams& r) { return r.closed; });
+  }
   /// What is wrong with the state, "" if nothing (sim::rods_problem: each rod's spacing, triads,
   /// finiteness; the spacing tolerance widened for thermal noise).
   std::string state_check() const;
@@ -132,25 +155,20 @@ class Simulation {
   /// The implicit scheme (nullptr for the explicit one).
   integrate::ImplicitIntegrator* implicit() { return implicit_.get(); }
   const integrate::ImplicitIntegrator* implicit() const { return implicit_.get(); }
-  /// Implicit: what a checkpoint must keep besides rod and clock (the controller's next Δt and
-  /// run of accepted steps), and putting it back. checkpoint_taken() is to be called where a
-  /// checkpoint is written, so that the run and its resumption refresh the scheme's stiffness
-  /// at the same step (resume stays bitwise). No-ops for the explicit scheme.
-  integrate::ImplicitIntegrator::State implicit_state() const {
-    return implicit_ ? implicit_->state() : integrate::ImplicitIntegrator::State{p_.dt, 0};
-  }
-  void restore_implicit_state(const integrate::ImplicitIntegrator::State& st) {
-    if (implicit_) implicit_->restore(st);
-  }
+  /// The dynamical state (Snapshot): rod, fluid velocity (with_velocity; collective when the
+  /// fluid is distributed: the whole velocity on rank 0 only), clock and the implicit scheme's
+  /// controller.
+  Snapshot snapshot(bool with_velocity = true) const;
+  /// Puts a Snapshot back (a checkpoint's on resume, the stability test's saved state): the rod
+  /// as it is (no check), the fluid velocity (every rank passes the whole velocity; collective),
+  /// the step counter and simulated time, and the implicit controller (when next_dt > 0; K is
+  /// then refreshed at the next step).
+  void restore(const Snapshot& s);
+  /// To be called where a checkpoint is written, so that the run and its resumption refresh the
+  /// implicit scheme's stiffness at the same step (resume stays bitwise). No-op for the explicit
+  /// scheme.
   void checkpoint_taken() {
     if (implicit_) implicit_->refresh();
-  }
-  /// Sets the step counter and the simulated time when a checkpoint restores rod() and the fluid
-  /// velocity; nothing else of the state depends on them.
-  void restore_clock(std::int64_t step, double time) {
-    step_ = step;
-    time_ = time;
-    prev_time_ = time;
   }
   /// Moves the end of the time (t_end, s; > 0): a run continued in segments (the Python module's
   /// `run(steps=…)`, driver::Run::set_end_time). Throws std::invalid_argument if not positive.

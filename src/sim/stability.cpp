@@ -115,23 +115,10 @@ ProbeOutcome probe_stability(Simulation& sim, const StabilityProbe& p, std::uint
   o.E_before_kT = before.E_total_kT;
   o.writhe_before = before.writhe;
 
-  // 1. save
-  const rod::RodState saved_rod = sim.rod();
-  std::vector<double> scratch;
-  const auto u = sim.stepper().whole_velocity(scratch);
-  const std::size_t n3 = sim.params().stepper.grid.size();
-  std::vector<double> saved_u(3 * n3);
-  for (int c = 0; c < 3; ++c) std::copy_n(u[std::size_t(c)], n3, saved_u.begin() + c * n3);
-  const std::int64_t saved_step = sim.step_count();
-  const double saved_time = sim.time();
-  const auto saved_implicit = sim.implicit_state();  // time.scheme = "implicit": its controller
-  auto restore = [&] {
-    sim.rod() = saved_rod;
-    const double* v = saved_u.data();
-    sim.stepper().set_whole_velocity({v, v + n3, v + 2 * n3});
-    sim.restore_clock(saved_step, saved_time);
-    sim.restore_implicit_state(saved_implicit);
-  };
+  // 1. save: the whole dynamical state (Simulation::snapshot, as a checkpoint keeps it)
+  const Snapshot saved = sim.snapshot();
+  const double saved_time = saved.time;
+  auto restore = [&] { sim.restore(saved); };
 
   // 2. the continuation
   Trace cont, kicked;
@@ -141,9 +128,15 @@ ProbeOutcome probe_stability(Simulation& sim, const StabilityProbe& p, std::uint
   o.writhe_continuation = continuation.writhe;
   restore();
 
-  // 3. the kicked copy
+  // 3. the kicked copy: every rod of the collection on its own range, in order, each drawing its
+  // kick from the same generator in turn (rod 0's kick is the one a run of that rod alone gets)
   std::mt19937_64 g(p.seed + index);
-  kick(sim.rod(), sim.params().stepper.rod.closed, p, g);
+  rod::RodState one;
+  for (const rod::RodRange& r : sim.rod_ranges()) {
+    rod::extract(sim.rod(), r, one);
+    kick(one, r.closed, p, g);
+    rod::insert(sim.rod(), r, one);
+  }
   o.steps = integrate(sim, saved_time, p.time, kicked);
   o.duration_us = (sim.time() - saved_time) / 1e-6;
   const Observables after = sim.observe();

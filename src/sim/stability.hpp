@@ -9,14 +9,17 @@
 //      E₀ = E_total of the state
 //   2. the continuation: integrate the state as it is for T; E_c = E_total at its end; put the
 //      saved state back
-//   3. the kicked copy: move the positions out of the rod's mean plane,
+//   3. the kicked copy: each rod of the collection in turn (several rods, issue 25: every rod on
+//      its own points, about its own centroid and plane; an open rod with one-sided tangents at
+//      its ends), move the positions out of the rod's mean plane,
 //        δX_k = a n [cos(2φ_k + φ₂) + u₃ cos(3φ_k + φ₃)]
 //      (n the normal of the plane of least gyration, φ_k the azimuth of X_k about the centroid
 //      in that plane, a the amplitude in Å, u₃ uniform in [−1, 1), φ₂, φ₃ uniform in [0, 2π)),
 //      turn each triad by the smallest rotation that takes its old tangent to the new one (a pure
 //      bend, no twist), then perturb the twist: D_k ← R(g(s_k) D³_k) D_k,
 //      g(s) = A Σ_{m=1..M} u_m sin(m s/r0 + ψ_m) (zero mean: the link is unchanged; A in rad);
-//      all drawn from std::mt19937_64(seed + probe index), 53-bit uniforms; integrate for T;
+//      all drawn from std::mt19937_64(seed + probe index), 53-bit uniforms, rod after rod from
+//      the one generator (rod 0 gets the kick a run of it alone gets); integrate for T;
 //      E₁ = E_total at its end
 //   4. both copies' E_total are sampled at 100 equal divisions of T; unstable if at any sample
 //      E₁(τ) < E_c(τ) − tolerance (E_c interpolated to the kicked copy's sample times): the

@@ -1,7 +1,9 @@
 // The stability-aware stop ([study], sim/stability.hpp): a state the kinetic-energy rule calls an
 // equilibrium is tested by perturbing a copy. The twisted circle above the Michell threshold
 // (ΔLk = 3 for a1 = 1.3e-19, a3 = 1.82e-19 erg·cm: threshold √3 a1/a3 ≈ 1.2) with no perturbation
-// sits on an unstable equilibrium; below it (ΔLk = 1) the circle is stable.
+// sits on an unstable equilibrium; below it (ΔLk = 1) the circle is stable. With several rods
+// (issue 25) every rod is kicked: two uncharged rings side by side, one of them above the
+// threshold, are found unstable and that one buckles; two below it stop as a verified equilibrium.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -41,6 +43,28 @@ fs::path circle_config(const fs::path& d, int excess_link) {
 double final_writhe(const fs::path& out) {
   const io::CsvTable t = io::read_csv_table(out / "timeseries.csv");
   return t.column("writhe").back();
+}
+
+// Two rings of circle_config (100 points, r0 = 54 Å) stacked on a common axis 50 Å apart,
+// uncharged (so that only the fluid couples them and the pair comes to rest), with ΔLk = dlk0
+// and dlk1; the stop rule and probe of circle_config.
+fs::path two_rings_config(const fs::path& d, int dlk0, int dlk1) {
+  config::Config c = small_config(dlk0);
+  c.rod_perturbation = {0.0};
+  c.electrostatics_enabled = false;
+  c.time_t_end_us = 0.5;
+  c.time_stop_kinetic_kT = 1e-8;
+  c.time_stability_probe_us = 0.2;
+  c.output_every_steps = 100;
+  c.output_frame_every_steps = 0;
+  c.output_checkpoint_every_steps = 0;
+  c.run_threads = 1;
+  config::apply_override(c, "rods.0.offset_A=[0, 0, -25]");
+  config::apply_override(c, "rods.1.offset_A=[0, 0, 25]");
+  config::apply_override(c, "rods.1.excess_link=" + std::to_string(dlk1));
+  const fs::path p = d / ("rings" + std::to_string(dlk0) + std::to_string(dlk1) + ".toml");
+  std::ofstream(p) << small_config_toml(c);
+  return p;
 }
 
 }  // namespace
@@ -95,5 +119,36 @@ TEST(StabilityTest, AStableCircleStopsAsAVerifiedEquilibriumAtTheTestedState) {
   EXPECT_LT(t.column("step").back(), 1000);
   EXPECT_LT(std::abs(final_writhe(d / "out")), 1e-3);
   EXPECT_NEAR(t.column("E_total_kT").back(), first["E_total_before_kT"].get<double>(), 1e-6);
+  fs::remove_all(d);
+}
+
+TEST(StabilityTest, SeveralRodsAreEachKickedAndTheUnstableOneBuckles) {
+  const fs::path d = fresh_dir("stability_rods");
+  // ring 1 above the threshold (ΔLk = 3), ring 0 below it (ΔLk = 1): only a kick of ring 1 (not
+  // the first rod's alone, nor one of all points as one curve) finds the unstable mode
+  const Exit on = run_ibrod({"run", two_rings_config(d, 1, 3).string(), "-o", (d / "on").string()},
+                            d / "on.log");
+  ASSERT_EQ(on.code, 0) << on.output;
+  EXPECT_THAT(on.output, HasSubstr("not an equilibrium"));
+  const std::string summary = read_file(d / "on" / "summary.json");
+  EXPECT_THAT(summary, HasSubstr("\"stable\": false"));
+  EXPECT_THAT(summary, ::testing::Not(HasSubstr("\"stop_reason\": \"equilibrium\"")));
+  const io::CsvTable rods = io::read_csv_table(d / "on" / "rods.csv");
+  EXPECT_LT(std::abs(rods.column("writhe_0").back()), 0.05);  // the stable ring stays a circle
+  EXPECT_GT(std::abs(rods.column("writhe_1").back()), 0.5);   // the unstable one buckles
+  EXPECT_NEAR(rods.column("link_0").back(), 1.0, 1e-3);
+  EXPECT_NEAR(rods.column("link_1").back(), 3.0, 1e-3);
+
+  // both below the threshold: a verified equilibrium at the tested state
+  const Exit st = run_ibrod(
+      {"run", two_rings_config(d, 1, 1).string(), "-o", (d / "stable").string()}, d / "st.log");
+  ASSERT_EQ(st.code, 0) << st.output;
+  const std::string s2 = read_file(d / "stable" / "summary.json");
+  EXPECT_THAT(s2, HasSubstr("\"stop_reason\": \"equilibrium\""));
+  EXPECT_THAT(s2, HasSubstr("\"equilibrium_verified\": true"));
+  const auto first = nlohmann::json::parse(s2)["stability_tests"][0];
+  EXPECT_GE(first["E_difference_min_kT"].get<double>(), -1e-6) << first.dump();
+  EXPECT_GT(first["E_total_after_kT"].get<double>(),
+            first["E_total_continuation_kT"].get<double>() - 1e-6);
   fs::remove_all(d);
 }

@@ -1,6 +1,8 @@
 // Unit tests of the parts of the implicit scheme (issue 14): the Gauss–Newton stiffness (analytic
 // small-strain form against finite differences; symmetric, positive semi-definite), the Stokes
-// mobility (symmetric, positive), undo(). 16³, 60-point ring: well under a second.
+// mobility (symmetric, positive), undo(). 16³, 60-point ring: well under a second. Any collection
+// of rods (issue 25): an open rod's K has no link past its ends, several rods' K is block-diagonal
+// (each rod's alone), and the block solver gives the sparse Cholesky's step on both.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -10,6 +12,7 @@
 
 #include "config/config.hpp"
 #include "integrate/implicit.hpp"
+#include "sim/simulation.hpp"
 
 namespace ibrod::integrate {
 namespace {
@@ -153,6 +156,98 @@ TEST(ImplicitStepper, UndoRestoresTheStateAndTheEnergyBookkeeping) {
   EXPECT_LT(b.energy_after, b.energy_before);
 }
 
+// A collection of rods from a configuration (sim::initial_state), strained as Ring's.
+struct Rods {
+  sim::SimParams p;
+  rod::RodState rod;
+  std::unique_ptr<Stepper> st;
+  explicit Rods(const config::Config& c) {
+    p = config::to_params(c);
+    rod = sim::initial_state(p);
+    std::mt19937_64 rng(13);
+    std::normal_distribution<double> N(0, 1);
+    for (int k = 0; k < rod.size(); ++k) {
+      rod.X[k] += 0.3 * Vec3(N(rng), N(rng), N(rng));
+      rod.D[k] = rotation(0.05 * Vec3(N(rng), N(rng), N(rng))) * rod.D[k];
+    }
+    st = std::make_unique<Stepper>(p.stepper);
+  }
+};
+
+config::Config small(int bp) {
+  config::Config c;
+  c.grid_n = 16;
+  c.grid_box_A = 200;
+  c.rod_base_pairs = bp;
+  c.rod_excess_link = 0;
+  c.run_threads = 1;
+  c.run_fftw_measure = false;
+  return c;
+}
+// an open rod of 30 points with intrinsic curvature and twist (a helix when relaxed)
+config::Config open_rod() {
+  config::Config c = small(30);
+  config::apply_override(c, "rod.closed=false");
+  config::apply_override(c, "rod.intrinsic_curvature_per_A=[0.04, 0.0]");
+  config::apply_override(c, "rod.intrinsic_twist_per_A=0.04");
+  return c;
+}
+// a ring of 40 and an open rod of 24 points, apart (no contacts)
+config::Config ring_and_open_rod() {
+  config::Config c = small(40);
+  config::apply_override(c, "rods.0.offset_A=[0, 0, -40]");
+  config::apply_override(c, "rods.1.offset_A=[0, 0, 40]");
+  config::apply_override(c, "rods.1.base_pairs=24");
+  config::apply_override(c, "rods.1.closed=false");
+  return c;
+}
+
+Eigen::MatrixXd dense_K(Rods& s, bool fd) {
+  ImplicitParams ip;
+  ip.stiffness_fd = fd;
+  ImplicitStepper imp(*s.st, ip);
+  return Eigen::MatrixXd(imp.stiffness(s.rod));
+}
+
+TEST(ImplicitStiffness, OpenRodHasNoLinkPastItsEnds) {
+  Rods s(open_rod());
+  const int n = s.rod.size();
+  const Eigen::MatrixXd Ka = dense_K(s, false), Kf = dense_K(s, true);
+  ASSERT_EQ(Ka.rows(), 6 * n);
+  const double rel = (Ka - Kf).norm() / Kf.norm();
+  EXPECT_LT(rel, 5e-2);  // measured 1.3e-2 (as the ring's: small-strain terms)
+  EXPECT_LT((Ka - Ka.transpose()).norm(), 1e-12 * Ka.norm());
+  // no block couples the two ends (the ring's wrap-around link), in either K
+  EXPECT_EQ(Ka.block(0, 6 * (n - 1), 6, 6).norm(), 0.0);
+  EXPECT_EQ(Kf.block(0, 6 * (n - 1), 6, 6).norm(), 0.0);
+  EXPECT_EQ(Kf.block(6 * (n - 1), 0, 6, 6).norm(), 0.0);
+  // rigid translations are in its null space
+  Eigen::VectorXd t = Eigen::VectorXd::Zero(Ka.rows());
+  for (int k = 0; k < n; ++k) t[6 * k + 1] = 1;
+  EXPECT_LT((Ka * t).norm(), 1e-10 * Ka.norm() * t.norm());
+}
+
+TEST(ImplicitStiffness, SeveralRodsAreBlockDiagonalEachRodAlone) {
+  Rods both(ring_and_open_rod());
+  const std::vector<rod::RodRange> g = rod::ranges_of(all_rods(both.p.stepper));
+  ASSERT_EQ(g.size(), 2u);
+  for (const bool fd : {false, true}) {
+    const Eigen::MatrixXd K = dense_K(both, fd);
+    // the off-diagonal rod–rod blocks are zero (no contacts: the rods are 80 Å apart)
+    EXPECT_EQ(K.block(0, 6 * g[1].offset, 6 * g[0].n, 6 * g[1].n).norm(), 0.0);
+    // each diagonal block is the rod's own K, computed alone
+    for (int r = 0; r < 2; ++r) {
+      config::Config c = config::rod_config(ring_and_open_rod(), r);
+      c.rods.clear();
+      Rods one(c);
+      rod::extract(both.rod, g[r], one.rod);
+      const Eigen::MatrixXd Kr = dense_K(one, fd);
+      const Eigen::MatrixXd blk = K.block(6 * g[r].offset, 6 * g[r].offset, 6 * g[r].n, 6 * g[r].n);
+      EXPECT_LT((blk - Kr).norm(), 1e-12 * Kr.norm()) << r << " fd " << fd;
+    }
+  }
+}
+
 TEST(ImplicitStepper, BlockSolverAndSparseCholeskyGiveTheSameStep) {
   // no contacts (the ring of Ring): the block-cyclic fast path against the general sparse one
   Ring a, b;
@@ -170,6 +265,29 @@ TEST(ImplicitStepper, BlockSolverAndSparseCholeskyGiveTheSameStep) {
   }
   EXPECT_LT(d, 1e-9 * u);
   EXPECT_GT(u, 0.0);
+}
+
+// The block path (one tridiagonal factor for the open rod, one cyclic for the ring) against the
+// general sparse Cholesky of the whole K, on an open rod alone and on a ring with an open rod.
+TEST(ImplicitStepper, BlockSolverMatchesSparseCholeskyOnOpenAndSeveralRods) {
+  for (const config::Config& c : {open_rod(), ring_and_open_rod()}) {
+    Rods a(c), b(c);
+    ImplicitParams pa, pb;
+    pb.block_solver = false;
+    ImplicitStepper ia(*a.st, pa), ib(*b.st, pb);
+    for (int k = 0; k < 3; ++k) {
+      ia.step(a.rod, 2e-9);
+      ib.step(b.rod, 2e-9);
+    }
+    EXPECT_EQ(ia.contacts(), 0);
+    double d = 0, u = 0;
+    for (int k = 0; k < a.rod.size(); ++k) {
+      d = std::max(d, (ia.velocities()[k] - ib.velocities()[k]).norm());
+      u = std::max(u, ib.velocities()[k].norm());
+    }
+    EXPECT_LT(d, 1e-9 * u) << config::rod_count(c);
+    EXPECT_GT(u, 0.0);
+  }
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-// Steric repulsion between several rods (StericParams::chains): segments of different rods always
+// Steric repulsion between several rods (StericParams::rods): segments of different rods always
 // count as a pair, even where their indices are neighbours in the point list (the last point of
 // one rod and the first of the next are not a segment); the cell list equals the direct sum and
 // an oracle over the rods' own segments; one chain equals the plain closed rod.
@@ -25,7 +25,7 @@ TEST(StericRods, TwoRodsCellListEqualsDirectAndOracle) {
   StericParams p;
   p.stiffness = g;
   p.ds = mean_spacing(X);
-  p.chains = {{0, half, p.ds, false}, {half, n - half, p.ds, false}};
+  p.rods = {{0, half, false, p.ds}, {half, n - half, false, p.ds}};
   Steric st(p, n);
   std::vector<Vec3> F(n, Vec3::Zero()), Fd(n, Vec3::Zero());
   const double E = st.accumulate(X, F);
@@ -52,21 +52,21 @@ TEST(StericRods, TwoRodsCellListEqualsDirectAndOracle) {
   EXPECT_LT(max_rel_diff(F, Fd), 1e-12);
   // as one open rod, the strands' pairs within 2D of the hairpin are skipped: less energy
   StericParams one = p;
-  one.chains.clear();
+  one.rods.clear();
   one.closed = false;
   EXPECT_LT(Steric(one, n).energy(X), E);
   // a single chain is the plain rod, bit for bit
   StericParams chain = p;
-  chain.chains = {{0, n, p.ds, true}};
+  chain.rods = {{0, n, true, p.ds}};
   StericParams plain = p;
-  plain.chains.clear();
+  plain.rods.clear();
   plain.closed = true;
   std::vector<Vec3> Fa(n, Vec3::Zero()), Fb(n, Vec3::Zero());
   EXPECT_EQ(Steric(chain, n).accumulate(X, Fa), Steric(plain, n).accumulate(X, Fb));
   EXPECT_EQ(Fa, Fb);
-  // chains that do not cover the points are refused
+  // ranges that do not cover the points are refused
   StericParams gap = p;
-  gap.chains = {{0, half, p.ds, false}, {half + 1, n - half - 1, p.ds, false}};
+  gap.rods = {{0, half, false, p.ds}, {half + 1, n - half - 1, false, p.ds}};
   EXPECT_THROW(Steric(gap, n), std::invalid_argument);
 }
 

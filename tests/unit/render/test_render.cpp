@@ -458,7 +458,7 @@ TEST(Render, SeveralRodsAreSeparateTubes) {
       d1.emplace_back(0, 0, 1);
     }
   Style two;
-  two.rods = {{60, false}, {60, false}};
+  two.rods = {{0, 60, false}, {60, 60, false}};
   Style one;
   one.closed = false;
   const int w = 200, h = 200;
@@ -477,7 +477,7 @@ TEST(Render, SeveralRodsAreSeparateTubes) {
   for (int y = 0; y < h; ++y) rods += !is_background(a.at(w / 2, y));
   EXPECT_GT(rods, 10);
   Style bad = two;
-  bad.rods = {{60, false}, {50, false}};
+  bad.rods = {{0, 60, false}, {60, 50, false}};
   EXPECT_THROW(render_rod(X, d1, 20.0, standard_view("top"), w, h, bad), std::invalid_argument);
 }
 }  // namespace
