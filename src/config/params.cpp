@@ -88,6 +88,14 @@ void validate_one(const Config& c) {
     bad("time.implicit_krylov_iterations", std::to_string(c.time_implicit_krylov_iterations),
         "0 with time.implicit_order = 2 (GMRES corrects the order-1 step only; set "
         "time.implicit_order = 1)");
+  if (c.time_scheme == "implicit" && c.time_implicit_local_mobility == "overlap" &&
+      2 * (4 * c.grid_kernel_width + 2) > c.grid_n)
+    bad("time.implicit_local_mobility", "\"overlap\"",
+        "\"self\" on a grid of fewer than 2 (4 grid.kernel_width + 2) = " +
+            std::to_string(2 * (4 * c.grid_kernel_width + 2)) +
+            " points per edge (grid.n = " + std::to_string(c.grid_n) +
+            "): a kernel would overlap another one both ways round the "
+            "periodic box");
   if (c.time_scheme == "implicit" && c.time_dt_min_ns > c.time_dt_ns)
     bad("time.dt_min_ns", fmt(c.time_dt_min_ns),
         "at most time.dt_ns = " + fmt(c.time_dt_ns) + " ns (the implicit scheme's largest step)");

@@ -66,10 +66,12 @@ ImplicitStepper::ImplicitStepper(Stepper& stepper, const ImplicitParams& p)
   m_r_ = W[0].z();
   scale_t_ = std::sqrt(m_r_ / m_t_);
   // the overlap's self blocks at the same point, to scale it to the self mobilities
-  const Eigen::SparseMatrix<double> O1 =
-      kernel_overlap(X, st_.params().grid, st_.params().kernel_width);
-  ov_t_ = std::sqrt(m_t_ / O1.coeff(0, 0));
-  ov_r_ = std::sqrt(m_r_ / O1.coeff(3, 3));
+  if (p_.local_mobility == ImplicitParams::LocalMobility::overlap) {
+    const Eigen::SparseMatrix<double> O1 =
+        kernel_overlap(X, st_.params().grid, st_.params().kernel_width);
+    ov_t_ = std::sqrt(m_t_ / O1.coeff(0, 0));
+    ov_r_ = std::sqrt(m_r_ / O1.coeff(3, 3));
+  }
 }
 
 ImplicitStepper::~ImplicitStepper() = default;

@@ -25,10 +25,11 @@ Eigen::SparseMatrix<double> kernel_overlap(std::span<const Vec3> X, const GridSp
 
 Eigen::SparseMatrix<double> kernel_overlap(std::span<const Vec3> X, const GridSpec& grid, int m,
                                            double window, bool closed) {
-  if (m < 1 || m > ib::kMaxKernelWidth || 4 * m + 2 > grid.n)
+  // 2 (4m + 2) ≤ n: two stencils overlap one way round the periodic box at most
+  if (m < 1 || m > ib::kMaxKernelWidth || 2 * (4 * m + 2) > grid.n)
     throw std::invalid_argument("kernel_overlap: kernel width " + std::to_string(m) +
                                 " not in 1 … " + std::to_string(ib::kMaxKernelWidth) +
-                                " or its stencil wider than the grid");
+                                " or twice its stencil wider than the grid");
   ib::detail::check_positions(X, grid.h());
   if (closed && window > 0 && X.size() < 2 * window)
     throw std::invalid_argument("kernel_overlap: a closed chain of " + std::to_string(X.size()) +

@@ -80,6 +80,16 @@ TEST(SchemeKeys, TheOverlapLocalMobilityAndItsScaleReachTheParameters) {
     EXPECT_THAT(e.what(), HasSubstr("\"overlap\""));
   }
   EXPECT_THROW(config::apply_override(c, "time.implicit_overlap_scale=0"), ConfigError);
+  // a grid on which two kernels would overlap both ways round the box
+  config::apply_override(c, "time.implicit_local_mobility=\"overlap\"");
+  config::apply_override(c, "grid.n=10");
+  try {
+    config::validate(c);
+    FAIL() << "accepted the overlap on a 10³ grid";
+  } catch (const ConfigError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("time.implicit_local_mobility"));
+    EXPECT_THAT(e.what(), HasSubstr("grid.n = 10"));
+  }
 }
 
 TEST(SchemeKeys, OrderTwoAndItsErrorToleranceReachTheParameters) {

@@ -120,6 +120,8 @@ TEST(KernelOverlap, TheChainTaperKeepsItPositiveAndDropsDistantStrands) {
 TEST(KernelOverlap, RefusesAKernelWiderThanTheGrid) {
   const std::vector<Vec3> X{Vec3(1, 1, 1)};
   EXPECT_THROW(kernel_overlap(X, GridSpec{8, 10.0}, 2), std::invalid_argument);
+  EXPECT_THROW(kernel_overlap(X, GridSpec{10, 10.0}, 1), std::invalid_argument);  // 2·6 > 10
+  EXPECT_NO_THROW(kernel_overlap(X, GridSpec{12, 10.0}, 1));
   EXPECT_THROW(kernel_overlap(X, GridSpec{8, 10.0}, 0), std::invalid_argument);
 }
 
