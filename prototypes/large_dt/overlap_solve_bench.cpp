@@ -66,34 +66,35 @@ int main(int argc, char** argv) {
     for (int i = 0; i < 6 * n; ++i) A.coeffRef(i, i) += 1.0;
     A.makeCompressed();
   });
-  std::printf("n = %d: K %.2f ms (nnz %ld), overlap %.2f ms (nnz %ld), A = I + dt M K %.2f ms "
-              "(nnz %ld, %.0f per row)\n",
-              n, t_k, long(K.nonZeros()), t_o, long(O.nonZeros()), t_a, long(A.nonZeros()),
-              double(A.nonZeros()) / A.rows());
+  std::printf(
+      "n = %d: K %.2f ms (nnz %ld), overlap %.2f ms (nnz %ld), A = I + dt M K %.2f ms "
+      "(nnz %ld, %.0f per row)\n",
+      n, t_k, long(K.nonZeros()), t_o, long(O.nonZeros()), t_a, long(A.nonZeros()),
+      double(A.nonZeros()) / A.rows());
   Eigen::VectorXd v = Eigen::VectorXd::Random(6 * n), x;
   {
     Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> lu;
     const double ta = time_ms([&] { lu.analyzePattern(A); });
     const double tf = time_ms([&] { lu.factorize(A); });
     const double ts = time_ms([&] { x = lu.solve(v); });
-    std::printf("SparseLU COLAMD : analyze %.2f factorize %.2f solve %.3f ms, residual %.2e\n",
-                ta, tf, ts, (A * x - v).norm() / v.norm());
+    std::printf("SparseLU COLAMD : analyze %.2f factorize %.2f solve %.3f ms, residual %.2e\n", ta,
+                tf, ts, (A * x - v).norm() / v.norm());
   }
   {
     Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::NaturalOrdering<int>> lu;
     const double ta = time_ms([&] { lu.analyzePattern(A); });
     const double tf = time_ms([&] { lu.factorize(A); });
     const double ts = time_ms([&] { x = lu.solve(v); });
-    std::printf("SparseLU natural: analyze %.2f factorize %.2f solve %.3f ms, residual %.2e\n",
-                ta, tf, ts, (A * x - v).norm() / v.norm());
+    std::printf("SparseLU natural: analyze %.2f factorize %.2f solve %.3f ms, residual %.2e\n", ta,
+                tf, ts, (A * x - v).norm() / v.norm());
   }
   {
     Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::AMDOrdering<int>> lu;
     const double ta = time_ms([&] { lu.analyzePattern(A); });
     const double tf = time_ms([&] { lu.factorize(A); });
     const double ts = time_ms([&] { x = lu.solve(v); });
-    std::printf("SparseLU AMD    : analyze %.2f factorize %.2f solve %.3f ms, residual %.2e\n",
-                ta, tf, ts, (A * x - v).norm() / v.norm());
+    std::printf("SparseLU AMD    : analyze %.2f factorize %.2f solve %.3f ms, residual %.2e\n", ta,
+                tf, ts, (A * x - v).norm() / v.norm());
   }
   // matrix-free application of A (for iterative refinement against a kept factorisation)
   const double tm = time_ms([&] { x = v + dt * (O * (K * v)); }, 10);
