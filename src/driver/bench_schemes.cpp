@@ -46,6 +46,14 @@ SchemeBenchResult bench_schemes(const config::Config& c, int explicit_steps, dou
     r.implicit_rejections = s.implicit()->rejections();
     r.implicit_ms_per_step = 1e3 * wall / double(s.step_count());
     r.us_per_hour_implicit = s.time() / 1e-6 / wall * 3600;
+    const integrate::ImplicitTimings& t = s.implicit()->stepper().timings();
+    const double per = 1e3 / double(s.step_count());
+    r.ms_forces = t.forces * per;
+    r.ms_stiffness = t.stiffness * per;
+    r.ms_overlap = t.overlap * per;
+    r.ms_factorize = t.factorize * per;
+    r.ms_local_solve = t.local_solve * per;
+    r.ms_stokes = t.stokes * per;
   }
   return r;
 }
@@ -59,6 +67,11 @@ void print_bench_schemes(const SchemeBenchResult& r, std::FILE* out) {
                r.explicit_steps, r.explicit_dt_ns, r.explicit_ms_per_step, r.implicit_ns,
                r.implicit_steps, r.implicit_dt_max_ns, r.implicit_ns / double(r.implicit_steps),
                r.implicit_rejections, r.implicit_ms_per_step, r.ratio());
+  std::fprintf(out,
+               "implicit, ms per step: forces %.2f, stiffness %.2f (M_loc %.2f), factorisation "
+               "%.2f, local solves %.2f, Stokes solves %.2f\n",
+               r.ms_forces, r.ms_stiffness, r.ms_overlap, r.ms_factorize, r.ms_local_solve,
+               r.ms_stokes);
   std::fprintf(out, "us_per_hour_explicit=%.4g us_per_hour_implicit=%.4g\n", r.us_per_hour_explicit,
                r.us_per_hour_implicit);
 }

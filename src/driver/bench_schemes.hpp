@@ -17,6 +17,10 @@ struct SchemeBenchResult {
   long implicit_steps = 0, implicit_rejections = 0;
   double implicit_ms_per_step = 0;
   double us_per_hour_explicit = 0, us_per_hour_implicit = 0;
+  /// where the implicit step's time went, ms per accepted step (trials included): forces, K and
+  /// M_loc (overlap: of which M_loc), the local factorisation, local solves, Stokes solves
+  double ms_forces = 0, ms_stiffness = 0, ms_overlap = 0, ms_factorize = 0, ms_local_solve = 0,
+         ms_stokes = 0;
   double ratio() const { return us_per_hour_implicit / us_per_hour_explicit; }
 };
 
@@ -25,7 +29,7 @@ struct SchemeBenchResult {
 /// as configured), both from the configured initial state.
 SchemeBenchResult bench_schemes(const config::Config& c, int explicit_steps, double implicit_dt_ns,
                                 double implicit_ns);
-/// Prints the two; the last line is `us_per_hour_explicit=… us_per_hour_implicit=…`.
+/// Prints the two and the implicit step's parts; the last line is `us_per_hour_explicit=… us_per_hour_implicit=…`.
 void print_bench_schemes(const SchemeBenchResult& r, std::FILE* out);
 
 }  // namespace ibrod::driver

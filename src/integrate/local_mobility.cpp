@@ -1,8 +1,8 @@
 #include "integrate/local_mobility.hpp"
 
 #include <algorithm>
+#include <cstdlib>
 #include <stdexcept>
-#include <utility>
 #include <vector>
 
 #include "ib/kernel.hpp"
@@ -41,13 +41,6 @@ Eigen::SparseMatrix<double> kernel_overlap(std::span<const Vec3> X, const GridSp
   st.reserve(n);
   for (const Vec3& x : X) st.emplace_back(x, grid, m);
   const int S = 4 * m + 2;
-  // the blocks of each overlapping pair j ≤ k, then the columns in order
-  struct Block {
-    int j, k;
-    Eigen::Matrix<double, 6, 6> B;
-  };
-  std::vector<Block> blocks;
-  blocks.reserve(std::size_t(n) * 16);
   // offset of k's stencil from j's in dimension d, in (−n/2, n/2]; |o| ≥ S: no overlap
   auto offset = [&](int j, int k, int d) {
     int o = st[k].idx[d][0] - st[j].idx[d][0];
@@ -55,83 +48,103 @@ Eigen::SparseMatrix<double> kernel_overlap(std::span<const Vec3> X, const GridSp
     if (o <= -grid.n / 2) o += grid.n;
     return o;
   };
+  auto taper_of = [&](int j, int k) {
+    if (window <= 0) return 1.0;
+    const int a = std::abs(k - j);
+    const int d = closed ? std::min(a, n - a) : a;
+    return 1 - d / window;
+  };
+  // the points by the x index of their stencil (counting sort), so that each point meets only
+  // those within 2S − 1 x planes (distinct planes: 2S ≤ grid.n)
+  std::vector<int> first(grid.n + 1, 0), by_x(n);
+  for (int j = 0; j < n; ++j) ++first[st[j].idx[0][0] + 1];
+  for (int i = 0; i < grid.n; ++i) first[i + 1] += first[i];
+  {
+    std::vector<int> fill(first.begin(), first.end() - 1);
+    for (int j = 0; j < n; ++j) by_x[fill[st[j].idx[0][0]]++] = j;
+  }
+  // each point's overlapping partners (itself included), ascending: the rows of its column block
+  std::vector<std::vector<int>> partners(n);
   for (int j = 0; j < n; ++j) {
-    for (int k = j; k < n; ++k) {
-      int o[3];
-      bool overlap = true;
-      for (int d = 0; d < 3 && overlap; ++d) {
-        o[d] = offset(j, k, d);
-        overlap = o[d] > -S && o[d] < S;
+    for (int dx = -(S - 1); dx <= S - 1; ++dx) {
+      const int i = ((st[j].idx[0][0] + dx) % grid.n + grid.n) % grid.n;
+      for (int b = first[i]; b < first[i + 1]; ++b) {
+        const int k = by_x[b];
+        if (std::abs(offset(j, k, 1)) >= S || std::abs(offset(j, k, 2)) >= S) continue;
+        if (taper_of(j, k) <= 0) continue;
+        partners[j].push_back(k);
       }
-      if (!overlap) continue;
-      double taper = 1;
-      if (window > 0) {
-        const int d = closed ? std::min(k - j, n - (k - j)) : k - j;
-        taper = 1 - d / window;
-        if (taper <= 0) continue;
-      }
-      // 1-D sums (times h) of φ_j φ_k, dφ_j φ_k, φ_j dφ_k, dφ_j dφ_k over the common indices
-      double pp[3], dp[3], pd[3], dd[3];
-      for (int d = 0; d < 3; ++d) {
-        pp[d] = dp[d] = pd[d] = dd[d] = 0;
-        const int q0 = std::max(0, o[d]), q1 = std::min(S, S + o[d]);
-        const double* pj = st[j].phi[d];
-        const double* dj = st[j].dphi[d];
-        const double* pk = st[k].phi[d];
-        const double* dk = st[k].dphi[d];
-        for (int q = q0; q < q1; ++q) {
-          const int r = q - o[d];
-          pp[d] += pj[q] * pk[r];
-          dp[d] += dj[q] * pk[r];
-          pd[d] += pj[q] * dk[r];
-          dd[d] += dj[q] * dk[r];
-        }
-        pp[d] *= h;
-        dp[d] *= h;
-        pd[d] *= h;
-        dd[d] *= h;
-      }
-      const double w = pp[0] * pp[1] * pp[2];
-      auto other = [](int a, int b) { return 3 - a - b; };
-      Eigen::Matrix3d G;  // h³ Σ g_j,a g_k,b
-      Vec3 a, b;          // h³ Σ w_j g_k, h³ Σ w_k g_j
-      for (int p = 0; p < 3; ++p) {
-        const int q = (p + 1) % 3, r = (p + 2) % 3;
-        a[p] = pd[p] * pp[q] * pp[r];
-        b[p] = dp[p] * pp[q] * pp[r];
-        G(p, p) = dd[p] * pp[q] * pp[r];
-        for (int c = 0; c < 3; ++c)
-          if (c != p) G(p, c) = dp[p] * pd[c] * pp[other(p, c)];
-      }
-      Eigen::Matrix<double, 6, 6> B;
-      B.topLeftCorner<3, 3>() = w * Eigen::Matrix3d::Identity();
-      B.topRightCorner<3, 3>() = 0.5 * cross_matrix(a);
-      B.bottomLeftCorner<3, 3>() = -0.5 * cross_matrix(b);
-      B.bottomRightCorner<3, 3>() =
-          0.25 * (G.trace() * Eigen::Matrix3d::Identity() - G.transpose());
-      if (taper != 1) B *= taper;
-      blocks.push_back({j, k, B});
     }
+    std::sort(partners[j].begin(), partners[j].end());
   }
-  // column block k holds B(j, k) for j ≤ k and B(k, j)ᵀ for j > k; rows ascending
-  std::vector<std::vector<std::pair<int, int>>> col(n);  // (row point, block index, ± transposed)
-  for (int b = 0; b < int(blocks.size()); ++b) {
-    col[blocks[b].k].emplace_back(blocks[b].j, b);
-    if (blocks[b].j != blocks[b].k) col[blocks[b].j].emplace_back(blocks[b].k, ~b);
-  }
+  // the (j, k) block: 1-D sums (times h) of φ_j φ_k, dφ_j φ_k, φ_j dφ_k, dφ_j dφ_k over the
+  // common indices. Block (k, j) is its transpose exactly (the same products, summed in the same
+  // order along each dimension).
+  auto pair_block = [&](int j, int k, Eigen::Matrix<double, 6, 6>& B) {
+    double pp[3], dp[3], pd[3], dd[3];
+    for (int d = 0; d < 3; ++d) {
+      const int o = offset(j, k, d);
+      pp[d] = dp[d] = pd[d] = dd[d] = 0;
+      const int q0 = std::max(0, o), q1 = std::min(S, S + o);
+      const double* pj = st[j].phi[d];
+      const double* dj = st[j].dphi[d];
+      const double* pk = st[k].phi[d];
+      const double* dk = st[k].dphi[d];
+      for (int q = q0; q < q1; ++q) {
+        const int r = q - o;
+        pp[d] += pj[q] * pk[r];
+        dp[d] += dj[q] * pk[r];
+        pd[d] += pj[q] * dk[r];
+        dd[d] += dj[q] * dk[r];
+      }
+      pp[d] *= h;
+      dp[d] *= h;
+      pd[d] *= h;
+      dd[d] *= h;
+    }
+    const double w = pp[0] * pp[1] * pp[2];
+    auto other = [](int a, int b) { return 3 - a - b; };
+    Eigen::Matrix3d G;  // h³ Σ g_j,a g_k,b
+    Vec3 a, b;          // h³ Σ w_j g_k, h³ Σ w_k g_j
+    for (int p = 0; p < 3; ++p) {
+      const int q = (p + 1) % 3, r = (p + 2) % 3;
+      a[p] = pd[p] * pp[q] * pp[r];
+      b[p] = dp[p] * pp[q] * pp[r];
+      G(p, p) = dd[p] * pp[q] * pp[r];
+      for (int c = 0; c < 3; ++c)
+        if (c != p) G(p, c) = dp[p] * pd[c] * pp[other(p, c)];
+    }
+    B.topLeftCorner<3, 3>() = w * Eigen::Matrix3d::Identity();
+    B.topRightCorner<3, 3>() = 0.5 * cross_matrix(a);
+    B.bottomLeftCorner<3, 3>() = -0.5 * cross_matrix(b);
+    B.bottomRightCorner<3, 3>() = 0.25 * (G.trace() * Eigen::Matrix3d::Identity() - G.transpose());
+    const double t = taper_of(j, k);
+    if (t != 1) B *= t;
+  };
   Eigen::SparseMatrix<double> O(6 * n, 6 * n);
   std::size_t nnz = 0;
-  for (const auto& c : col) nnz += 36 * c.size();
+  for (const auto& c : partners) nnz += 36 * c.size();
   O.reserve(Eigen::Index(nnz));
+  std::vector<Eigen::Matrix<double, 6, 6>> col;
   for (int k = 0; k < n; ++k) {
-    std::sort(col[k].begin(), col[k].end());
+    col.resize(partners[k].size());
+    for (std::size_t a = 0; a < partners[k].size(); ++a) {
+      const int j = partners[k][a];
+      // a block below the diagonal is the transpose of the one above: O exactly symmetric
+      if (j <= k) {
+        pair_block(j, k, col[a]);
+      } else {
+        Eigen::Matrix<double, 6, 6> B;
+        pair_block(k, j, B);
+        col[a] = B.transpose();
+      }
+    }
     for (int c = 0; c < 6; ++c) {
       O.startVec(6 * k + c);
-      for (const auto& [j, b] : col[k]) {
-        const bool transposed = b < 0;
-        const Eigen::Matrix<double, 6, 6>& B = blocks[transposed ? ~b : b].B;
+      for (std::size_t a = 0; a < partners[k].size(); ++a) {
+        const int j = partners[k][a];
         for (int r = 0; r < 6; ++r) {
-          const double v = transposed ? B(c, r) : B(r, c);
+          const double v = col[a](r, c);
           if (v != 0) O.insertBack(6 * j + r, 6 * k + c) = v;
         }
       }

@@ -30,8 +30,9 @@
 namespace ibrod::integrate {
 
 /// O = 𝒥 𝒮 at positions X for kernel width m (c = m h), 6n × 6n, per point (x, y, z, θx, θy, θz);
-/// units Å⁻³ (FF), Å⁻⁴ (FT, TF), Å⁻⁵ (TT). All pairs are checked (O(n²) integer comparisons of
-/// the stencils' first grid indices, periodically); the sums are O(m) per overlapping pair.
+/// units Å⁻³ (FF), Å⁻⁴ (FT, TF), Å⁻⁵ (TT). The overlapping pairs are found among the points whose
+/// stencils start within 4m + 1 x planes of each other (a counting sort by x plane, then integer
+/// comparisons of the y and z indices, periodically); the sums are O(m) per overlapping pair.
 /// Throws std::invalid_argument for m < 1, m > ib::kMaxKernelWidth or 2 (4m + 2) > grid.n.
 Eigen::SparseMatrix<double> kernel_overlap(std::span<const Vec3> X, const GridSpec& grid, int m);
 
