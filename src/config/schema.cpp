@@ -419,10 +419,6 @@ const std::vector<Key>& schema() {
               "implicit, time.implicit_local_mobility = \"overlap\": steps between refreshes of "
               "M_loc, the stiffness and their LU (which costs ~10 Stokes solves at the "
               "reference; > 1: a run resumed after a signal is not bitwise the same)"),
-      integer("time.implicit_overlap_refine", &Config::time_implicit_overlap_refine, 0, 20,
-              "implicit, time.implicit_local_mobility = \"overlap\": corrections of each local "
-              "solve against the current M_loc and stiffness, with the LU of the latest refresh "
-              "(0: that LU's own system between refreshes)"),
       integer("time.implicit_jacobian_every", &Config::time_implicit_jacobian_every, 1, 1000000,
               "implicit: steps between refreshes of the stiffness and its factorisation (> 1: "
               "faster; a run resumed after a signal is then not bitwise the same)"),

@@ -178,11 +178,7 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
   pack(c0.F, c0.T, b);
 
   if (local || p_.krylov_max_iter > 0) {
-    const bool overlap_mode = p_.local_mobility == ImplicitParams::LocalMobility::overlap;
-    const bool refresh = steps_since_jacobian_ == 0 || !have_K_;
-    // with overlap_refine, K and M_loc are the current W's at every step; the LU is refreshed
-    // every jacobian_every steps
-    if (refresh || (overlap_mode && local && p_.overlap_refine > 0)) {
+    if (steps_since_jacobian_ == 0 || !have_K_) {
       const double t0 = now();
       // the fast path: no contacts, the local system is block-diagonal over the rods, each
       // block block-cyclic-tridiagonal (closed) or block-tridiagonal (open)
@@ -218,10 +214,8 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
       }
       have_K_ = true;
       timings_.stiffness += now() - t0;
-      if (refresh) {
-        info.jacobian_refreshed = true;
-        lu_dt_ = -1;
-      }
+      info.jacobian_refreshed = true;
+      lu_dt_ = -1;
     }
     steps_since_jacobian_ = (steps_since_jacobian_ + 1) % p_.jacobian_every;
   }
@@ -234,7 +228,6 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
   // (Δt/Δt') r < 2)
   const bool keep = p_.local_mobility == ImplicitParams::LocalMobility::overlap && lu_dt_ > 0 &&
                     wdt >= 0.5 * lu_dt_ && wdt <= 1.5 * lu_dt_;
-  w_dt_ = wdt;
   if (local && lu_dt_ != wdt && !keep) {
     const double t0 = now();
     factorize(wdt);

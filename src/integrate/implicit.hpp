@@ -75,10 +75,6 @@ struct ImplicitParams {
   /// out of M_loc, so that close strands of a supercoil do not fill the LU (0: no taper, the
   /// default: at 3 reaches the 64³ path runs ahead, docs/large_dt.md; one rod only)
   double overlap_window = 0.0;
-  /// overlap: corrections of each local solve against the current W = I + γΔt M_loc K (K and
-  /// M_loc taken at qⁿ every step) with the LU of the latest refresh (every jacobian_every
-  /// steps): x ← x + LU⁻¹ (v − W x). 0: the kept LU's own W between refreshes
-  int overlap_refine = 0;
   double fd_dx = 1e-4;      ///< finite-difference step of K in positions, Å
   double fd_dtheta = 1e-5;  ///< ... and in rotation vectors, rad
 };
@@ -185,7 +181,6 @@ class ImplicitStepper {
   Eigen::Index pattern_nnz_ = 0;
   int contacts_ = 0, pattern_contacts_ = 0;  // steric contacts in K, in the analysed pattern
   double lu_dt_ = -1;                        // dt of the current factorisation (−1: none)
-  double w_dt_ = 0;                          // γΔt of the current step's W (overlap_refine)
   long steps_since_jacobian_ = 0;
   StepEnergies last_;
   ImplicitTimings timings_;

@@ -424,16 +424,8 @@ Eigen::VectorXd ImplicitStepper::local_solve(const Eigen::VectorXd& v) const {
       bcc_[r].solve(x.segment(6 * ranges_[r].offset, 6 * ranges_[r].n));
     return p_.velocity_form ? x : VectorXd(x.cwiseQuotient(mloc_));
   }
-  if (p_.local_mobility == ImplicitParams::LocalMobility::overlap) {
-    VectorXd x = lu_.solve(v);
-    if (p_.velocity_form)
-      for (int it = 0; it < p_.overlap_refine; ++it) {
-        const VectorXd r = v - x - w_dt_ * (Mov_ * (K_ * x));
-        x += lu_.solve(r);
-      }
-    return x;
-  }
-  if (!p_.gauss_newton) return lu_.solve(v);
+  if (!p_.gauss_newton || p_.local_mobility == ImplicitParams::LocalMobility::overlap)
+    return lu_.solve(v);
   // velocity form: (I + Δt M_loc K) x = v ⇔ S x = M_loc⁻¹ v;
   // force form: (I + Δt K M_loc) x = v ⇔ S (M_loc x) = v
   if (p_.velocity_form) return llt_.solve(VectorXd(v.cwiseQuotient(mloc_)));
