@@ -54,6 +54,7 @@ SchemeBenchResult bench_schemes(const config::Config& c, int explicit_steps, dou
     r.ms_factorize = t.factorize * per;
     r.ms_local_solve = t.local_solve * per;
     r.ms_stokes = t.stokes * per;
+    r.factorizations = t.factorizations;
   }
   return r;
 }
@@ -69,9 +70,9 @@ void print_bench_schemes(const SchemeBenchResult& r, std::FILE* out) {
                r.implicit_rejections, r.implicit_ms_per_step, r.ratio());
   std::fprintf(out,
                "implicit, ms per step: forces %.2f, stiffness %.2f (M_loc %.2f), factorisation "
-               "%.2f, local solves %.2f, Stokes solves %.2f\n",
-               r.ms_forces, r.ms_stiffness, r.ms_overlap, r.ms_factorize, r.ms_local_solve,
-               r.ms_stokes);
+               "%.2f (%ld of them), local solves %.2f, Stokes solves %.2f\n",
+               r.ms_forces, r.ms_stiffness, r.ms_overlap, r.ms_factorize, r.factorizations,
+               r.ms_local_solve, r.ms_stokes);
   std::fprintf(out, "us_per_hour_explicit=%.4g us_per_hour_implicit=%.4g\n", r.us_per_hour_explicit,
                r.us_per_hour_implicit);
 }

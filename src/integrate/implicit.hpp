@@ -101,6 +101,7 @@ struct ImplicitTimings {
   double forces = 0, stiffness = 0, factorize = 0, local_solve = 0, stokes = 0;
   double overlap = 0;  ///< building M_loc = β D O D (in stiffness too)
   double analyze = 0;  ///< the LU's pattern analysis (in factorize too)
+  long factorizations = 0;  ///< of the local system (count)
 };
 
 class ImplicitStepper {
