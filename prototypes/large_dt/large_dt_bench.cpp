@@ -62,7 +62,7 @@ int main(int argc, char** argv) {
     integrate::ImplicitParams ip;
     ip.mobility_scale = std::stod(kv["beta"]);
     if (std::stoi(kv["jac_every"]) > 0) ip.jacobian_every = std::stoi(kv["jac_every"]);
-    integrate::ImplicitStepper imp(st, ip);
+    integrate::ImplicitStepper imp(st.system(), ip);
     integrate::AdaptiveDtParams ap;
     ap.dt_max = std::stod(kv["dt_max_ns"]) * 1e-9;
     ap.dt_min = 1e-3 * ap.dt_max;

@@ -79,7 +79,7 @@ int main(int argc, char** argv) {
   ip.local_mobility = kv["mloc"] == "overlap" ? integrate::ImplicitParams::LocalMobility::overlap
                                               : integrate::ImplicitParams::LocalMobility::self;
   std::unique_ptr<integrate::ImplicitStepper> imp;
-  if (scheme != "explicit") imp = std::make_unique<integrate::ImplicitStepper>(st, ip);
+  if (scheme != "explicit") imp = std::make_unique<integrate::ImplicitStepper>(st.system(), ip);
   if (imp)
     std::printf("# self mobility m_t = %.4g A/s per g A/s^2, m_r = %.4g 1/s per g A^2/s^2\n",
                 imp->self_mobility_translation(), imp->self_mobility_rotation());
@@ -89,8 +89,8 @@ int main(int argc, char** argv) {
   };
   auto potential = [&]() {
     double e = rod::elastic_energy(p.stepper.rod, rod).total();
-    if (p.stepper.electro.enabled) e += st.electrostatics().energy(rod.X);
-    if (p.stepper.steric.enabled) e += st.steric().energy(rod.X);
+    if (p.stepper.electro.enabled) e += st.system().electrostatics().energy(rod.X);
+    if (p.stepper.steric.enabled) e += st.system().steric().energy(rod.X);
     return e / kT;
   };
   (void)energy;

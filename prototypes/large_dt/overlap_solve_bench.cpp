@@ -45,7 +45,7 @@ int main(int argc, char** argv) {
   rod::RodState s = rod::twisted_circle(p.stepper.rod, p.circle);
   integrate::Stepper st(p.stepper);
   integrate::ImplicitParams ip;
-  integrate::ImplicitStepper imp(st, ip);
+  integrate::ImplicitStepper imp(st.system(), ip);
   const int n = s.size();
   Eigen::SparseMatrix<double> K;
   const double t_k = time_ms([&] { K = imp.stiffness(s); });

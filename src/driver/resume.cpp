@@ -156,7 +156,7 @@ void Run::State::restore_state() {
     checkpoint.reset();  // the state lives in sim now; free the copy
   }
   meta.config_toml = config_text;
-  meta.threads = sim->stepper().fluid_threads();
+  meta.threads = sim->system().fluid_threads();
   meta.stop_reason = to_string(StopReason::none);
   wall_before = meta.wall_s;
 }

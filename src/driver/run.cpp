@@ -217,7 +217,7 @@ std::string Run::State::progress_line(const sim::Observables& o) const {
 void Run::State::write_frame() {
   if (sim->params().output.frames <= 0 || !writes()) return;
   std::array<const double*, 3> u{};
-  if (c.output_fluid_vti) u = sim->stepper().whole_velocity(gathered);
+  if (c.output_fluid_vti) u = sim->system().whole_velocity(gathered);
   on_root([&] { files->frame(*sim, u); });
 }
 
@@ -251,7 +251,7 @@ void Run::State::finish(const sim::Observables& o, const std::string& stop_reaso
   const bool npy = writes() && error.empty() && stop_reason != to_string(StopReason::interrupted) &&
                    c.output_fluid_velocity;
   std::array<const double*, 3> u{};
-  if (npy) u = sim->stepper().whole_velocity(gathered);
+  if (npy) u = sim->system().whole_velocity(gathered);
   on_disk([&] {
     files->check_directory(r.steps);
     if (error.empty())
@@ -377,7 +377,7 @@ RunResult Run::State::loop(const std::function<int()>& pending, std::int64_t max
   // the step's OpenMP loops on the run's thread count in the thread that runs them: OpenMP keeps
   // the count per thread, and the Python module may advance a run from a worker thread (where
   // the default count would sum the per-thread pair-force buffers in another order)
-  omp_set_num_threads(s.stepper().fluid_threads());
+  omp_set_num_threads(s.system().fluid_threads());
   loop_start = Clock::now();
   start_step = s.step_count();
   result.signal = 0;

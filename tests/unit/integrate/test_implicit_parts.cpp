@@ -20,7 +20,7 @@ namespace {
 struct Ring {
   sim::SimParams p;
   rod::RodState rod;
-  std::unique_ptr<Stepper> st;
+  std::unique_ptr<System> st;
   explicit Ring(int excess_link = 2, bool per_link_moduli = false) {
     config::Config c;
     c.grid_n = 16;
@@ -51,7 +51,7 @@ struct Ring {
       rod.X[k] += 0.3 * Vec3(N(rng), N(rng), N(rng));
       rod.D[k] = rotation(0.05 * Vec3(N(rng), N(rng), N(rng))) * rod.D[k];
     }
-    st = std::make_unique<Stepper>(p.stepper);
+    st = std::make_unique<System>(p.stepper);
   }
 };
 
@@ -160,7 +160,7 @@ TEST(ImplicitStepper, UndoRestoresTheStateAndTheEnergyBookkeeping) {
 struct Rods {
   sim::SimParams p;
   rod::RodState rod;
-  std::unique_ptr<Stepper> st;
+  std::unique_ptr<System> st;
   explicit Rods(const config::Config& c) {
     p = config::to_params(c);
     rod = sim::initial_state(p);
@@ -170,7 +170,7 @@ struct Rods {
       rod.X[k] += 0.3 * Vec3(N(rng), N(rng), N(rng));
       rod.D[k] = rotation(0.05 * Vec3(N(rng), N(rng), N(rng))) * rod.D[k];
     }
-    st = std::make_unique<Stepper>(p.stepper);
+    st = std::make_unique<System>(p.stepper);
   }
 };
 
