@@ -43,7 +43,7 @@ int main(int argc, char** argv) {
   // explicit: the reference step
   double us_hour_explicit = 0;
   {
-    rod::RodState rod = rod::twisted_circle(p.stepper.rod, p.circle);
+    rod::RodState rod = rod::twisted_circle(p.stepper.rods[0], p.shapes[0].circle);
     integrate::Stepper st(p.stepper);
     for (int k = 0; k < 10; ++k) st.step(rod);  // warm-up
     const long n = std::stol(kv["explicit_steps"]);
@@ -57,7 +57,7 @@ int main(int argc, char** argv) {
   // implicit: IMEX, adaptive (docs/large_dt.md)
   double us_hour_implicit = 0;
   {
-    rod::RodState rod = rod::twisted_circle(p.stepper.rod, p.circle);
+    rod::RodState rod = rod::twisted_circle(p.stepper.rods[0], p.shapes[0].circle);
     integrate::Stepper st(p.stepper);
     integrate::ImplicitParams ip;
     ip.mobility_scale = std::stod(kv["beta"]);

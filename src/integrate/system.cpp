@@ -35,21 +35,14 @@ ib::XSlab slab_of(const GridSpec& grid, const fluid::DistributedFluid* d) {
 // the hard core follows the rods: each its own segments, closed (cyclic) or open
 interactions::StericParams steric_of(const StepperParams& p) {
   interactions::StericParams s = p.steric;
-  s.closed = p.rod.closed;
-  s.rods = rod::ranges_of(all_rods(p));
+  s.rods = rod::ranges_of(p.rods);
   return s;
 }
 }  // namespace
 
-std::vector<rod::RodParams> all_rods(const StepperParams& p) {
-  std::vector<rod::RodParams> r{p.rod};
-  r.insert(r.end(), p.more_rods.begin(), p.more_rods.end());
-  return r;
-}
-
 int point_count(const StepperParams& p) {
-  int n = p.rod.n;
-  for (const rod::RodParams& r : p.more_rods) n += r.n;
+  int n = 0;
+  for (const rod::RodParams& r : p.rods) n += r.n;
   return n;
 }
 
@@ -63,7 +56,7 @@ System::System(const StepperParams& p)
       electro_(p.electro, integrate::point_count(p)),
       steric_(steric_of(p), integrate::point_count(p)) {
   const int n = integrate::point_count(p);
-  rods_ = all_rods(p);
+  rods_ = p.rods;
   ranges_ = rod::ranges_of(rods_);
   const std::size_t R = rods_.size();
   rod_state_.resize(R);

@@ -26,10 +26,10 @@ struct StepperParams {
   GridSpec grid;
   int kernel_width = 1;  ///< c/h
   fluid::FluidParams fluid;
-  rod::RodParams rod;  ///< the rod (with several rods, the first)
-  /// Several rods (`[[rods]]`, docs/model.md "Several rods"): the second, third, … rod, whose
-  /// points follow the first rod's in the state (rod::RodRange). Empty: one rod.
-  std::vector<rod::RodParams> more_rods;
+  /// The rods (`[rod]`, or one per `[[rods]]` table; docs/model.md "Several rods"), resolved
+  /// once at load (config::to_params): their points lie in the state rod after rod
+  /// (rod::RodRange). One rod is a collection of one; never empty.
+  std::vector<rod::RodParams> rods{rod::RodParams{}};
   interactions::ElectroParams electro;
   interactions::StericParams steric;
   int threads = 0;           ///< OpenMP/FFTW threads, 0 = OpenMP default
@@ -50,8 +50,6 @@ struct StepperParams {
   bool thermal_drift = false;
 };
 
-/// Every rod of p, in the state's order: p.rod, then p.more_rods.
-std::vector<rod::RodParams> all_rods(const StepperParams& p);
 /// Points of all rods together (the size of the state and of every per-point buffer).
 int point_count(const StepperParams& p);
 

@@ -65,11 +65,8 @@ SimParams checked(SimParams p) {
     p.stop_kinetic = 0;
     p.stability.enabled = false;
   }
-  if (!p.stepper.more_rods.empty()) {
-    if (p.more_circles.size() != p.stepper.more_rods.size() ||
-        p.more_rotations.size() != p.stepper.more_rods.size())
-      throw std::invalid_argument("Simulation: one initial shape per rod");
-  }
+  if (p.stepper.rods.empty() || p.shapes.size() != p.stepper.rods.size())
+    throw std::invalid_argument("Simulation: one rod at least, and one initial shape per rod");
   if (p.scheme == TimeScheme::implicit_step) {
     if (p.stepper.distributed)
       throw std::invalid_argument("Simulation: the implicit scheme runs on one process only");
@@ -80,7 +77,8 @@ SimParams checked(SimParams p) {
     if (!(a.max_displacement > 0)) {
       // the pair forces stay explicit: a step moves no point by more than a fifth of the
       // shorter of their ranges (Debye length, hard-core diameter)
-      double range = p.stepper.rod.ds * 10;
+      double range = HUGE_VAL;
+      for (const rod::RodParams& r : p.stepper.rods) range = std::min(range, r.ds * 10);
       if (p.stepper.electro.enabled && p.stepper.electro.law.kappa > 0)
         range = 1 / p.stepper.electro.law.kappa;
       if (p.stepper.steric.enabled) range = std::min(range, p.stepper.steric.diameter);
@@ -94,19 +92,20 @@ SimParams checked(SimParams p) {
 }
 // One rod's initial shape: the twisted circle (closed) or the straight rod (open), turned about
 // its centroid by R.
-rod::RodState shape_of(const rod::RodParams& rp, const rod::CircleParams& c, const Mat3& R) {
+rod::RodState shape_of(const rod::RodParams& rp, const SimParams::Shape& shape) {
+  const rod::CircleParams& c = shape.circle;
   rod::RodState s =
       rp.closed ? rod::twisted_circle(rp, c) : rod::straight_rod(rp, c.perturbation, c.center);
-  if (!R.isIdentity(0)) rod::place(s, R, Vec3::Zero());
+  if (!shape.rotation.isIdentity(0)) rod::place(s, shape.rotation, Vec3::Zero());
   return s;
 }
 
 }  // namespace
 
 rod::RodState initial_state(const SimParams& p) {
-  rod::RodState s = shape_of(p.stepper.rod, p.circle, p.rotation);
-  for (std::size_t r = 0; r < p.stepper.more_rods.size(); ++r)
-    rod::append(s, shape_of(p.stepper.more_rods[r], p.more_circles[r], p.more_rotations[r]));
+  rod::RodState s;
+  for (std::size_t r = 0; r < p.stepper.rods.size(); ++r)
+    rod::append(s, shape_of(p.stepper.rods[r], p.shapes[r]));
   return s;
 }
 

@@ -44,14 +44,15 @@ std::string to_string(TimeScheme s);  ///< "explicit", "implicit"
 /// Everything a trajectory needs, in internal units (g, Å, s).
 struct SimParams {
   integrate::StepperParams stepper;  ///< its fluid.dt is set from dt by Simulation
-  /// The first (or only) rod's initial shape: the twisted circle (closed) or the straight rod
-  /// (open) of `circle` (its centre, link and twist perturbation), turned about its centroid by
-  /// `rotation` (rod.rotation_deg).
-  rod::CircleParams circle;
-  Mat3 rotation = Mat3::Identity();
-  /// Several rods: the same for stepper.more_rods, one each.
-  std::vector<rod::CircleParams> more_circles;
-  std::vector<Mat3> more_rotations;
+  /// A rod's initial shape: the twisted circle (closed) or the straight rod (open) of `circle`
+  /// (its centre, link and twist perturbation), turned about its centroid by `rotation`
+  /// (rod.rotation_deg).
+  struct Shape {
+    rod::CircleParams circle;
+    Mat3 rotation = Mat3::Identity();
+  };
+  /// One per rod of stepper.rods, in the same order.
+  std::vector<Shape> shapes{Shape{}};
   TimeScheme scheme = TimeScheme::explicit_step;
   /// implicit only: the scheme's knobs, and the controller's (its dt_max is set from dt; a
   /// dt_min ≤ 0 becomes 1e-3 dt, a max_displacement ≤ 0 becomes 0.2 min(1/κ, D))

@@ -28,7 +28,7 @@ struct Ring {
     config::Config c = test::small_config(3);
     c.run_threads = threads;
     p = config::to_params(c);
-    rod = rod::twisted_circle(p.stepper.rod, p.circle);
+    rod = rod::twisted_circle(p.stepper.rods[0], p.shapes[0].circle);
     st = std::make_unique<integrate::System>(p.stepper);
     integrate::ImplicitParams ip;
     ip.mobility_scale = beta;  // 0: the explicit Stokes-limit Euler step δ = Δt M F

@@ -26,7 +26,7 @@ struct Ring {
     c.run_threads = 1;
     c.rod_perturbation = perturbation;
     p = config::to_params(c);
-    rod = rod::twisted_circle(p.stepper.rod, p.circle);
+    rod = rod::twisted_circle(p.stepper.rods[0], p.shapes[0].circle);
     st = std::make_unique<integrate::System>(p.stepper);
     integrate::ImplicitParams ip;
     ip.mobility_scale = beta;  // 0: the explicit Stokes-limit Euler step δ = Δt M F

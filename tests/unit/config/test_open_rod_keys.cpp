@@ -35,12 +35,12 @@ config::Config open_rod() {
 
 TEST(OpenRodKeys, ClosedByDefaultOpenOnRequest) {
   config::Config c;
-  EXPECT_TRUE(config::to_params(c).stepper.rod.closed);
+  EXPECT_TRUE(config::to_params(c).stepper.rods[0].closed);
   EXPECT_TRUE(config::to_params(c).stepper.steric.closed);
   const config::Config o = open_rod();
   EXPECT_EQ(validation_error(o), "");
   const sim::SimParams p = config::to_params(o);
-  EXPECT_FALSE(p.stepper.rod.closed);
+  EXPECT_FALSE(p.stepper.rods[0].closed);
   EXPECT_FALSE(p.stepper.steric.closed);
   EXPECT_THAT(config::describe(o), HasSubstr("rod.closed"));
   EXPECT_THAT(config::to_toml(o), HasSubstr("closed = false"));

@@ -44,7 +44,7 @@ TEST(External, ForceAndTorqueAddTheirPointForces) {
   const std::vector<double> F{1.5, -2.0, 0.5}, tau{3.0, 1.0, -4.0};
   const sim::SimParams p0 = ring_params({0, 0, 0}, {0, 0, 0});
   const sim::SimParams p1 = ring_params(F, tau);
-  rod::RodState s = rod::twisted_circle(p0.stepper.rod, p0.circle);
+  rod::RodState s = rod::twisted_circle(p0.stepper.rods[0], p0.shapes[0].circle);
   // a generic shape: the ring tilted and bent a little
   for (int k = 0; k < s.size(); ++k)
     s.X[k] += Vec3(0.3 * std::sin(2.0 * k), 0, 2.0 * std::cos(k * 0.1));
@@ -71,7 +71,7 @@ TEST(External, ForceAndTorqueAddTheirPointForces) {
 // Mean velocity of the centroid over `steps` steps, Å/s.
 Vec3 pulled_velocity(double fx_pN, int steps) {
   const sim::SimParams p = ring_params({fx_pN, 0, 0}, {0, 0, 0});
-  rod::RodState s = rod::twisted_circle(p.stepper.rod, p.circle);
+  rod::RodState s = rod::twisted_circle(p.stepper.rods[0], p.shapes[0].circle);
   Stepper st(p.stepper);
   const Vec3 c0 = centroid(s.X);
   for (int i = 0; i < steps; ++i) st.step(s);
@@ -131,7 +131,7 @@ TEST(External, ImplicitSchemePullsTheRingAtTheExplicitVelocity) {
   (void)c0;
   // the explicit scheme's steady velocity, after 10 steps of start-up
   const sim::SimParams p = ring_params({1.0, 0, 0}, {0, 0, 0});
-  rod::RodState r = rod::twisted_circle(p.stepper.rod, p.circle);
+  rod::RodState r = rod::twisted_circle(p.stepper.rods[0], p.shapes[0].circle);
   Stepper st(p.stepper);
   for (int i = 0; i < 10; ++i) st.step(r);
   const Vec3 e0 = centroid(r.X);
@@ -148,7 +148,7 @@ TEST(External, ImplicitSchemePullsTheRingAtTheExplicitVelocity) {
 // √(2 kT M_self Δt).
 TEST(ThermalDrift, DivergenceOfTheMobilityIsSmallAgainstTheNoise) {
   const sim::SimParams p = ring_params({0, 0, 0}, {0, 0, 0});
-  rod::RodState s = rod::twisted_circle(p.stepper.rod, p.circle);
+  rod::RodState s = rod::twisted_circle(p.stepper.rods[0], p.shapes[0].circle);
   System st(p.stepper);
   ImplicitStepper imp(st, ImplicitParams{});
   const int n = s.size();
@@ -195,7 +195,7 @@ TEST(ThermalDrift, TheAddedDriftIsKTTimesTheDivergenceOfTheMobility) {
   sim::SimParams p = ring_params({0, 0, 0}, {0, 0, 0});
   p.stepper.electro.enabled = false;  // the twisted circle is then at rest without noise
   p.stepper.steric.enabled = false;
-  const rod::RodState s0 = rod::twisted_circle(p.stepper.rod, p.circle);
+  const rod::RodState s0 = rod::twisted_circle(p.stepper.rods[0], p.shapes[0].circle);
   const int n = s0.size();
   // kT ∂·M by central differences (as in the test above)
   System st0(p.stepper);

@@ -102,7 +102,7 @@ TEST(SeveralRods, BadTablesNameTheTableAndKey) {
 
 TEST(SeveralRods, ElasticForcesAreEachRodsOwn) {
   const sim::SimParams p = config::to_params(two_rings());
-  ASSERT_EQ(p.stepper.more_rods.size(), 1u);
+  ASSERT_EQ(p.stepper.rods.size(), 2u);
   sim::Simulation sim(p);
   rod::RodState s = sim.rod();
   std::mt19937_64 rng(3);
@@ -114,8 +114,8 @@ TEST(SeveralRods, ElasticForcesAreEachRodsOwn) {
   System st(sp);
   const StepEnergies e = st.compute_forces(s);
   double sum = 0;
-  const auto ranges = rod::ranges_of(all_rods(sp));
-  const auto rods = all_rods(sp);
+  const auto ranges = rod::ranges_of(sp.rods);
+  const auto rods = sp.rods;
   for (std::size_t r = 0; r < rods.size(); ++r) {
     rod::RodState one;
     rod::extract(s, ranges[r], one);
@@ -152,8 +152,7 @@ TEST(SeveralRods, PairForcesObeyNewtonsThirdLawAndAreMinusGradient) {
     rod::RodState one;
     rod::extract(s, ranges[r], one);
     StepperParams alone = sp;
-    alone.rod = all_rods(sp)[r];
-    alone.more_rods.clear();
+    alone.rods = {sp.rods[r]};
     System a(alone);
     a.compute_forces(one);
     for (int k = 0; k < one.size(); ++k) {
