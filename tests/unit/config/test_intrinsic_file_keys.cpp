@@ -49,7 +49,7 @@ TEST(IntrinsicFileKey, RowsReachTheRodInOrder) {
     text += std::to_string(0.001 * k) + ", " + std::to_string(-0.002 * k) + ",0.0436\r\n";
   const std::string path = write_file("ok.csv", text);
   const config::Config c = with_file(path, n);
-  const auto& rod = config::to_params(c).stepper.rods[0];
+  const rod::RodParams rod = config::to_params(c).stepper.rods[0];
   ASSERT_EQ(int(rod.omega0_k.size()), n);
   for (int k = 0; k < n; ++k) {
     EXPECT_DOUBLE_EQ(rod.omega0_k[k].x(), 0.001 * k);

@@ -56,7 +56,7 @@ TEST(ModuliFileKey, RowsReachTheRodInOrderInInternalUnits) {
     text += std::to_string(1 + k) + "e-19, 2e-19, 3e-19 , 4e-5,5e-5,\t6e-5\r\n";
   const std::string path = write_file("ok.csv", text);
   const config::Config c = with_file(path, n);
-  const auto& rod = config::to_params(c).stepper.rods[0];
+  const rod::RodParams rod = config::to_params(c).stepper.rods[0];
   ASSERT_EQ(int(rod.a_k.size()), n);
   ASSERT_EQ(int(rod.b_k.size()), n);
   double mean_a1 = 0;
