@@ -34,7 +34,7 @@ config::Config reference(int grid_n = 64, int points = 600, double salt = 0.1) {
 // The reference ring after some buckling: a few thousand steps are too slow for a benchmark, so
 // the circle gets a deterministic out-of-plane wave (what matters is the point distribution).
 rod::RodState ring(const sim::SimParams& p) {
-  rod::RodState s = rod::twisted_circle(p.stepper.rod, p.circle);
+  rod::RodState s = rod::twisted_circle(p.stepper.rods[0], p.shapes[0].circle);
   for (int k = 0; k < s.size(); ++k)
     s.X[k][2] += 20.0 * std::sin(3.0 * 2.0 * std::numbers::pi * k / s.size());
   return s;
@@ -130,7 +130,7 @@ void BM_ElasticForces(benchmark::State& st) {
   rod::RodWork w;
   w.resize(s.size());
   std::vector<Vec3> F(s.size()), T(s.size());
-  for (auto _ : st) benchmark::DoNotOptimize(rod::elastic_forces(p.stepper.rod, s, w, F, T));
+  for (auto _ : st) benchmark::DoNotOptimize(rod::elastic_forces(p.stepper.rods[0], s, w, F, T));
   st.SetItemsProcessed(st.iterations() * st.range(0));
 }
 BENCHMARK(BM_ElasticForces)->Arg(600)->Arg(6000)->Unit(benchmark::kMicrosecond)->UseRealTime();

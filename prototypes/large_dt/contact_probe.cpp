@@ -42,7 +42,7 @@ int main(int argc, char** argv) {
   integrate::ImplicitParams ip = p.implicit;
   ip.mobility_scale = std::stod(kv["beta"]);
   if (kv.count("order")) ip.order = std::stoi(kv["order"]);
-  integrate::ImplicitStepper imp(st, ip);
+  integrate::ImplicitStepper imp(st.system(), ip);
   integrate::AdaptiveDtParams ap = p.adaptive;
   ap.dt_max = dt;
   ap.dt_min = 1e-3 * dt;
@@ -84,7 +84,7 @@ int main(int argc, char** argv) {
     Uprev.assign(U.begin(), U.end());
     Wprev.assign(W.begin(), W.end());
     // the fluid's velocity is the Stokes velocity of M F(qⁿ): E_K as the run reports it
-    const double ek = st.fluid_kinetic_energy() / p.kT;
+    const double ek = st.system().fluid_kinetic_energy() / p.kT;
     if (s % every == 0 || s == steps - 1)
       std::printf("%d %.4f %.4g %.4e %.3e %.4e %+.4f %d%s\n", s, t * 1e9, h * 1e9, ek,
                   (info.energy_after - info.energy_before) / p.kT, umax * 1e-9, cosv,

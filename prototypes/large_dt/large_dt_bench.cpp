@@ -43,7 +43,7 @@ int main(int argc, char** argv) {
   // explicit: the reference step
   double us_hour_explicit = 0;
   {
-    rod::RodState rod = rod::twisted_circle(p.stepper.rod, p.circle);
+    rod::RodState rod = rod::twisted_circle(p.stepper.rods[0], p.shapes[0].circle);
     integrate::Stepper st(p.stepper);
     for (int k = 0; k < 10; ++k) st.step(rod);  // warm-up
     const long n = std::stol(kv["explicit_steps"]);
@@ -57,12 +57,12 @@ int main(int argc, char** argv) {
   // implicit: IMEX, adaptive (docs/large_dt.md)
   double us_hour_implicit = 0;
   {
-    rod::RodState rod = rod::twisted_circle(p.stepper.rod, p.circle);
+    rod::RodState rod = rod::twisted_circle(p.stepper.rods[0], p.shapes[0].circle);
     integrate::Stepper st(p.stepper);
     integrate::ImplicitParams ip;
     ip.mobility_scale = std::stod(kv["beta"]);
     if (std::stoi(kv["jac_every"]) > 0) ip.jacobian_every = std::stoi(kv["jac_every"]);
-    integrate::ImplicitStepper imp(st, ip);
+    integrate::ImplicitStepper imp(st.system(), ip);
     integrate::AdaptiveDtParams ap;
     ap.dt_max = std::stod(kv["dt_max_ns"]) * 1e-9;
     ap.dt_min = 1e-3 * ap.dt_max;

@@ -61,7 +61,7 @@ int main(int argc, char** argv) {
   const double out = std::stod(kv["out_ns"]) * 1e-9;
   cfg.time_dt_ns = std::stod(kv["dt_ns"]);
   sim::SimParams p = config::to_params(cfg);
-  rod::RodState rod = rod::twisted_circle(p.stepper.rod, p.circle);
+  rod::RodState rod = rod::twisted_circle(p.stepper.rods[0], p.shapes[0].circle);
   integrate::Stepper st(p.stepper);
   integrate::ImplicitParams ip;
   ip.mobility_scale = scheme == "stokes" ? 0.0 : std::stod(kv["beta"]);
@@ -79,7 +79,7 @@ int main(int argc, char** argv) {
   ip.local_mobility = kv["mloc"] == "overlap" ? integrate::ImplicitParams::LocalMobility::overlap
                                               : integrate::ImplicitParams::LocalMobility::self;
   std::unique_ptr<integrate::ImplicitStepper> imp;
-  if (scheme != "explicit") imp = std::make_unique<integrate::ImplicitStepper>(st, ip);
+  if (scheme != "explicit") imp = std::make_unique<integrate::ImplicitStepper>(st.system(), ip);
   if (imp)
     std::printf("# self mobility m_t = %.4g A/s per g A/s^2, m_r = %.4g 1/s per g A^2/s^2\n",
                 imp->self_mobility_translation(), imp->self_mobility_rotation());
@@ -88,9 +88,9 @@ int main(int argc, char** argv) {
     return (e.elastic.total() + e.electro + e.steric) / kT;
   };
   auto potential = [&]() {
-    double e = rod::elastic_energy(p.stepper.rod, rod).total();
-    if (p.stepper.electro.enabled) e += st.electrostatics().energy(rod.X);
-    if (p.stepper.steric.enabled) e += st.steric().energy(rod.X);
+    double e = rod::elastic_energy(p.stepper.rods[0], rod).total();
+    if (p.stepper.electro.enabled) e += st.system().electrostatics().energy(rod.X);
+    if (p.stepper.steric.enabled) e += st.system().steric().energy(rod.X);
     return e / kT;
   };
   (void)energy;
@@ -128,8 +128,8 @@ int main(int argc, char** argv) {
                   potential(), diagnostics::closest_approach(rod.X, 20), smin, smax, iters, solves,
                   maxdisp, (adaptive ? ctl.dt() : dt) * 1e9);
       while (next_out <= t + 1e-6 * dt) next_out += out;
-      if (!std::isfinite(wr) || smax > 1.5 * p.stepper.rod.ds || smin < 0.5 * p.stepper.rod.ds ||
-          std::abs(lk - lk0) > 0.1) {
+      if (!std::isfinite(wr) || smax > 1.5 * p.stepper.rods[0].ds ||
+          smin < 0.5 * p.stepper.rods[0].ds || std::abs(lk - lk0) > 0.1) {
         blown = true;
         std::printf("# BLOWUP at step %ld t = %.3f ns\n", s, t * 1e9);
         break;

@@ -42,10 +42,10 @@ int main(int argc, char** argv) {
   }
   const double dt = std::stod(kv["dt_ns"]) * 1e-9, beta = std::stod(kv["beta"]);
   sim::SimParams p = config::to_params(cfg);
-  rod::RodState s = rod::twisted_circle(p.stepper.rod, p.circle);
+  rod::RodState s = rod::twisted_circle(p.stepper.rods[0], p.shapes[0].circle);
   integrate::Stepper st(p.stepper);
   integrate::ImplicitParams ip;
-  integrate::ImplicitStepper imp(st, ip);
+  integrate::ImplicitStepper imp(st.system(), ip);
   const int n = s.size();
   Eigen::SparseMatrix<double> K;
   const double t_k = time_ms([&] { K = imp.stiffness(s); });

@@ -120,9 +120,9 @@ int main(int argc, char** argv) try {
   for (const auto& o : overrides) config::apply_override(cfg, o);
   config::validate(cfg);
   const sim::SimParams sp = config::to_params(cfg);
-  const rod::RodParams& p = sp.stepper.rod;
+  const rod::RodParams& p = sp.stepper.rods[0];
   const double kT = sp.kT;
-  rod::RodState s = rod::twisted_circle(p, sp.circle);
+  rod::RodState s = rod::twisted_circle(p, sp.shapes[0].circle);
   const int n = s.size();
   const double kt_max = 4 * p.b.maxCoeff() / p.ds, kr_max = 4 * p.a.maxCoeff() / p.ds;
   const double lam = std::stod(kv["lam"]), ratio = std::stod(kv["ratio"]);

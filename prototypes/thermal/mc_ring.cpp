@@ -73,8 +73,8 @@ int selftest(std::map<std::string, std::string>& kv) {
   config::apply_override(cfg, "rod.perturbation=[0.0]");
   config::apply_override(cfg, "solvent.salt_M=" + (kv.count("salt") ? kv["salt"] : "0.1"));
   const sim::SimParams p = config::to_params(cfg);
-  mc::RingEnergy E(p.stepper.rod, p.stepper.electro, p.stepper.steric, p.kT);
-  mc::RingMC mc(E, rod::twisted_circle(p.stepper.rod, p.circle), 7);
+  mc::RingEnergy E(p.stepper.rods[0], p.stepper.electro, p.stepper.steric, p.kT);
+  mc::RingMC mc(E, rod::twisted_circle(p.stepper.rods[0], p.shapes[0].circle), 7);
   const int sweeps = std::stoi(kv.count("sweeps") ? kv["sweeps"] : "4000");
   for (int i = 0; i < 200; ++i) mc.sweep(true);
   mc.reset_counts();
@@ -146,8 +146,9 @@ int main(int argc, char** argv) try {
   for (const auto& o : overrides) config::apply_override(cfg, o);
   config::validate(cfg);
   const sim::SimParams p = config::to_params(cfg);
-  mc::RingEnergy E(p.stepper.rod, p.stepper.electro, p.stepper.steric, p.kT);
-  mc::RingMC mc(E, rod::twisted_circle(p.stepper.rod, p.circle), std::stoull(kv["seed"]));
+  mc::RingEnergy E(p.stepper.rods[0], p.stepper.electro, p.stepper.steric, p.kT);
+  mc::RingMC mc(E, rod::twisted_circle(p.stepper.rods[0], p.shapes[0].circle),
+                std::stoull(kv["seed"]));
   const long sweeps = std::stol(kv["sweeps"]), burn = std::stol(kv["burn"]),
              every = std::stol(kv["every"]);
   const auto t0 = std::chrono::steady_clock::now();
@@ -186,7 +187,8 @@ int main(int argc, char** argv) try {
   print_rates(mc, "production");
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::fprintf(stderr, "Lk0 = %.6f; %ld + %ld sweeps of %d points, %.1f s (%.2f ms/sweep)\n",
-               mc.link0(), burn, sweeps, p.stepper.rod.n, wall, 1e3 * wall / double(burn + sweeps));
+               mc.link0(), burn, sweeps, p.stepper.rods[0].n, wall,
+               1e3 * wall / double(burn + sweeps));
   return 0;
 } catch (const std::exception& e) {
   std::fprintf(stderr, "mc_ring: %s\n", e.what());

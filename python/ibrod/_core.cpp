@@ -211,7 +211,7 @@ class PySimulation {
 
   py::array_t<double> fluid_velocity() {
     const int N = s().params().stepper.grid.n;
-    const auto u = s().stepper().whole_velocity(scratch_);
+    const auto u = s().system().whole_velocity(scratch_);
     const std::size_t n3 = std::size_t(N) * N * N;
     py::array_t<double> a({py::ssize_t(3), py::ssize_t(N), py::ssize_t(N), py::ssize_t(N)});
     double* p = a.mutable_data();

@@ -135,6 +135,24 @@ Config rod_config(const Config& c, int r);
 /// Points of all rods together.
 int point_count(const Config& c);
 
+/// One rod of the configuration, resolved: its keys and how messages name them.
+struct RodConfig {
+  Config keys;     ///< rod_config(c, table): [rod] with the table's keys on top (no [[rods]])
+  int table = -1;  ///< its [[rods]] table, −1 for [rod] alone
+  /// The full path of one of its keys: "rod.<key>" for [rod] alone, "rods.<table>.<key>".
+  std::string key(const std::string& k) const;
+  /// The heading of its errors: "" for [rod] alone, "[[rods]] table <table>: ".
+  std::string where() const;
+};
+/// The rods of c, resolved once, in the state's order: [rod] alone, or one per [[rods]] table.
+/// The driver, the files and the analysis walk this list instead of asking whether c has
+/// [[rods]] tables.
+std::vector<RodConfig> rod_configs(const Config& c);
+/// A message why old's rods cannot be continued as c's (a checkpoint's configuration against the
+/// resumed one: another count of rods, or a rod of another size or kind, closed or open); ""
+/// if they can.
+std::string rods_incompatibility(const Config& old, const Config& c);
+
 /// Parse a TOML document (file contents) on top of the defaults.
 void apply_toml(Config& c, const std::string& toml_text, const std::string& source_name);
 /// Load a TOML file on top of the defaults (an empty path: defaults only).

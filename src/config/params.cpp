@@ -28,16 +28,12 @@ void validate_one(const Config& c);
 }
 
 void validate(const Config& c) {
-  if (c.rods.empty()) {
-    validate_one(c);
-    return;
-  }
-  // several rods (docs/config.md "Several rods"): each rod as if alone, then what they share
-  for (int r = 0; r < rod_count(c); ++r) {
+  // each rod as if alone (docs/config.md "Several rods"); an error names its [[rods]] table
+  for (const RodConfig& rc : rod_configs(c)) {
     try {
-      validate_one(rod_config(c, r));
+      validate_one(rc.keys);
     } catch (const ConfigError& e) {
-      throw ConfigError("[[rods]] table " + std::to_string(r) + ": " + e.what());
+      throw ConfigError(rc.where() + e.what());
     }
   }
 }
@@ -313,24 +309,15 @@ sim::SimParams to_params(const Config& c) {
   p.dt = c.time_dt_ns * ns;
   s.fluid.dt = p.dt;
   s.fluid.advection = c.solvent_advection;
-  s.rod = rod_params(c);
-  p.circle = circle_params(c, s.grid.L);
-  p.rotation = rod::rotation_xyz_deg(
-      Vec3(c.rod_rotation_deg[0], c.rod_rotation_deg[1], c.rod_rotation_deg[2]));
-  if (!c.rods.empty()) {
-    // several rods: rod 0 above from table 0, the others after it (docs/config.md)
-    const Config c0 = rod_config(c, 0);
-    s.rod = rod_params(c0);
-    p.circle = circle_params(c0, s.grid.L);
-    p.rotation = rod::rotation_xyz_deg(
-        Vec3(c0.rod_rotation_deg[0], c0.rod_rotation_deg[1], c0.rod_rotation_deg[2]));
-    for (int r = 1; r < rod_count(c); ++r) {
-      const Config cr = rod_config(c, r);
-      s.more_rods.push_back(rod_params(cr));
-      p.more_circles.push_back(circle_params(cr, s.grid.L));
-      p.more_rotations.push_back(rod::rotation_xyz_deg(
-          Vec3(cr.rod_rotation_deg[0], cr.rod_rotation_deg[1], cr.rod_rotation_deg[2])));
-    }
+  // the rods, resolved once: [rod] alone or each [[rods]] table on top of it (docs/config.md)
+  s.rods.clear();
+  p.shapes.clear();
+  for (const RodConfig& rc : rod_configs(c)) {
+    const Config& cr = rc.keys;
+    s.rods.push_back(rod_params(cr));
+    p.shapes.push_back({circle_params(cr, s.grid.L),
+                        rod::rotation_xyz_deg(Vec3(cr.rod_rotation_deg[0], cr.rod_rotation_deg[1],
+                                                   cr.rod_rotation_deg[2]))});
   }
   p.kT = kT(c.solvent_temperature_K);
   // MODEL (2.19–2.22): A = q²/(4π ε0 εw), κ = 0.329 √Cs
@@ -340,8 +327,6 @@ sim::SimParams to_params(const Config& c) {
   s.steric.enabled = c.steric_enabled;
   s.steric.diameter = c.steric_diameter_A;
   s.steric.stiffness = c.steric_stiffness_kT_A2 * p.kT;
-  s.steric.ds = s.rod.ds;
-  s.steric.closed = s.rod.closed;
   // docs/thermal.md: the random stress at kT, keyed by run.seed; the external load
   s.fluid.thermal_kT = c.solvent_thermal ? p.kT : 0.0;
   s.fluid.seed = std::uint64_t(c.run_seed);
@@ -423,10 +408,11 @@ double output_estimate_bytes(const Config& c) {
 std::string derived_report(const Config& c) {
   const auto p = to_params(c);
   const auto& s = p.stepper;
+  const rod::RodParams& rod0 = s.rods.front();  // the ring's quantities: the first rod's
   const double h = s.grid.h();
-  const double r0 = rod::circle_radius(s.rod.n, s.rod.ds);
+  const double r0 = rod::circle_radius(rod0.n, rod0.ds);
   const double sin_beta =
-      rod::circle_tilt_sin_beta(s.rod.a[0], s.rod.a[2], s.rod.b[0], r0, c.rod_excess_link);
+      rod::circle_tilt_sin_beta(rod0.a[0], rod0.a[2], rod0.b[0], r0, c.rod_excess_link);
   const auto steps = sim::steps_to_reach(p.t_end, p.dt);
   const double N3 = double(s.grid.size());
   std::ostringstream os;
@@ -434,7 +420,7 @@ std::string derived_report(const Config& c) {
   os << "grid spacing h            = " << h << " Å\n"
      << "kernel width c            = " << c.grid_kernel_width * h << " Å (" << c.grid_kernel_width
      << " h)\n"
-     << "rod spacing Δs            = " << s.rod.ds << " Å\n"
+     << "rod spacing Δs            = " << rod0.ds << " Å\n"
      << "ring radius r0            = " << r0 << " Å\n"
      << "tilt angle β              = " << std::asin(sin_beta) << " rad\n"
      << "kT                        = " << p.kT << " g Å² s⁻²\n"
@@ -454,10 +440,10 @@ std::string derived_report(const Config& c) {
   // docs/outputs.md: checkpoint = 3 N³ velocities + 12 n rod numbers; a frame = 4 × n × 3 numbers
   std::int64_t frames = p.output.frames > 0 ? steps / p.output.frames + 1 : 0;
   if (p.output.frames_every > 0) frames = std::int64_t(p.t_end / p.output.frames_every) + 1;
-  os << "checkpoint size           = " << (24.0 * N3 + 96.0 * s.rod.n) / (1 << 20) << " MiB\n"
+  os << "checkpoint size           = " << (24.0 * N3 + 96.0 * rod0.n) / (1 << 20) << " MiB\n"
      << "trajectory frames         = " << frames << " (H5MD ≈ "
-     << frames * 96.0 * s.rod.n / (1 << 20) << " MiB, .vtp ≈ "
-     << frames * 270.0 * s.rod.n / (1 << 20) << " MiB)\n"
+     << frames * 96.0 * rod0.n / (1 << 20) << " MiB, .vtp ≈ " << frames * 270.0 * rod0.n / (1 << 20)
+     << " MiB)\n"
      << "output estimate           = " << output_estimate_bytes(c) / (1 << 20)
      << " MiB (rows and frames to t_end)\n";
   return os.str();

@@ -638,8 +638,44 @@ Config rod_config(const Config& c, int r) {
 
 int point_count(const Config& c) {
   int n = 0;
-  for (int r = 0; r < rod_count(c); ++r) n += rod_config(c, r).rod_base_pairs;
+  for (const RodConfig& rc : rod_configs(c)) n += rc.keys.rod_base_pairs;
   return n;
+}
+
+std::string RodConfig::key(const std::string& k) const {
+  return table < 0 ? "rod." + k : "rods." + std::to_string(table) + "." + k;
+}
+
+std::string RodConfig::where() const {
+  return table < 0 ? "" : "[[rods]] table " + std::to_string(table) + ": ";
+}
+
+std::vector<RodConfig> rod_configs(const Config& c) {
+  std::vector<RodConfig> out;
+  if (c.rods.empty()) {
+    out.push_back({rod_config(c, 0), -1});
+    return out;
+  }
+  for (int r = 0; r < int(c.rods.size()); ++r) out.push_back({rod_config(c, r), r});
+  return out;
+}
+
+std::string rods_incompatibility(const Config& old, const Config& c) {
+  const std::vector<RodConfig> a = rod_configs(old), b = rod_configs(c);
+  bool same = a.size() == b.size();
+  for (std::size_t r = 0; same && r < b.size(); ++r)
+    same = a[r].keys.rod_base_pairs == b[r].keys.rod_base_pairs &&
+           a[r].keys.rod_closed == b[r].keys.rod_closed;
+  if (same) return "";
+  // a closed ring and an open rod are different structures: never continued into each other
+  if (a.size() == 1 && b.size() == 1 && a[0].keys.rod_closed != b[0].keys.rod_closed)
+    return std::string(a[0].keys.rod_closed ? "a closed rod (rod.closed = true)"
+                                            : "an open rod (rod.closed = false)") +
+           "; the configuration asks for rod.closed = " + (b[0].keys.rod_closed ? "true" : "false");
+  return std::to_string(a.size()) +
+         " rods whose sizes or kinds (rod.base_pairs, rod.closed) differ from the "
+         "configuration's " +
+         std::to_string(b.size());
 }
 
 std::int64_t frame_every(const Config& c) {

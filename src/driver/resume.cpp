@@ -43,12 +43,9 @@ void Run::State::open_checkpoint() {
   if (ck.grid_n != c.grid_n || ck.rod.size() != config::point_count(c))
     throw ConfigError(
         "resume: " + cp.string() + " holds a " + std::to_string(ck.grid_n) + "³ grid and " +
-        std::to_string(ck.rod.size()) +
-        " rod points; the configuration asks for grid.n = " + std::to_string(c.grid_n) + " and " +
-        (c.rods.empty() ? "rod.base_pairs = " + std::to_string(c.rod_base_pairs)
-                        : std::to_string(config::point_count(c)) + " points in " +
-                              std::to_string(config::rod_count(c)) + " rods ([[rods]])") +
-        ": incompatible, even with --force");
+        std::to_string(ck.rod.size()) + " rod points; the configuration asks for grid.n = " +
+        std::to_string(c.grid_n) + " and " + std::to_string(config::point_count(c)) +
+        " rod points (rod.base_pairs, [[rods]])" + ": incompatible, even with --force");
   {
     // a closed ring and an open rod are different structures: never continued into each other
     config::Config old;
@@ -58,24 +55,10 @@ void Run::State::open_checkpoint() {
     } catch (const ConfigError&) {
       read = false;  // reported below by config_differences
     }
-    // several rods: the same rods, each of the same size and kind
-    bool same_rods = !read || config::rod_count(old) == config::rod_count(c);
-    for (int r = 0; read && same_rods && r < config::rod_count(c); ++r) {
-      const config::Config a = config::rod_config(old, r), b = config::rod_config(c, r);
-      same_rods = a.rod_base_pairs == b.rod_base_pairs && a.rod_closed == b.rod_closed;
-    }
-    if (!same_rods)
-      throw ConfigError("resume: " + cp.string() + " holds " +
-                        std::to_string(config::rod_count(old)) +
-                        " rods whose sizes or kinds (rod.base_pairs, rod.closed) differ from the "
-                        "configuration's " +
-                        std::to_string(config::rod_count(c)) + ": incompatible, even with --force");
-    if (read && old.rods.empty() && c.rods.empty() && old.rod_closed != c.rod_closed)
-      throw ConfigError(std::string("resume: ") + cp.string() + " holds " +
-                        (old.rod_closed ? "a closed rod (rod.closed = true)"
-                                        : "an open rod (rod.closed = false)") +
-                        "; the configuration asks for rod.closed = " +
-                        (c.rod_closed ? "true" : "false") + ": incompatible, even with --force");
+    // the same rods, each of the same size and kind
+    if (const std::string why = read ? config::rods_incompatibility(old, c) : ""; !why.empty())
+      throw ConfigError("resume: " + cp.string() + " holds " + why +
+                        ": incompatible, even with --force");
   }
   // the run's own checkpoint: its id is config.toml's (a checkpoint copied in from another run
   // directory would continue that run's state under this one's files)
@@ -156,7 +139,7 @@ void Run::State::restore_state() {
     checkpoint.reset();  // the state lives in sim now; free the copy
   }
   meta.config_toml = config_text;
-  meta.threads = sim->stepper().fluid_threads();
+  meta.threads = sim->system().fluid_threads();
   meta.stop_reason = to_string(StopReason::none);
   wall_before = meta.wall_s;
 }

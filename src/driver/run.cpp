@@ -89,14 +89,11 @@ void Run::State::build_simulation() {
     // the distributed fluid checks what every rank sees alike: a bad input on every rank
     throw ConfigError(std::string("run: ") + e.what());
   }
-  if (initial_shape && !checkpoint) {
-    sim->set_rod_state(std::move(*initial_shape));  // checked in Run::Run
-    initial_shape.reset();
-  }
   const bool any_shape =
       std::any_of(rod_shapes.begin(), rod_shapes.end(), [](const auto& r) { return bool(r); });
   if (any_shape && !checkpoint) {
-    // several rods: each rod with rod.initial_shape takes its shape from its file, in its range
+    // each rod with rod.initial_shape takes its shape from its file (checked in Run::Run), in its
+    // range
     rod::RodState whole = sim->rod();
     for (std::size_t r = 0; r < rod_shapes.size(); ++r) {
       if (!rod_shapes[r]) continue;
@@ -109,9 +106,9 @@ void Run::State::build_simulation() {
     sim->set_rod_state(std::move(whole), "rod.initial_shape");
     rod_shapes.clear();
   }
-  if (sim->rods().size() > 1 && !checkpoint)
+  if (!checkpoint)
     if (const std::string bad = sim->start_problem(); !bad.empty())
-      throw ConfigError("[[rods]]: the initial state: " + bad);
+      throw ConfigError("the initial state: " + bad);
   // distributed: rank 0 holds every rank's plans (fftw_mpi_gather_wisdom)
   on_disk([&] {
     const std::string wisdom = fluid::wisdom_text();
@@ -171,15 +168,16 @@ void Run::State::announce() {
                   dir.root().c_str(), static_cast<long long>(result.resumed_from),
                   static_cast<long long>(sim->end_step()), meta.threads,
                   static_cast<long long>(p.output.checkpoints));
-  else
+  else {
+    int excess_link = 0;  // the rods' together
+    for (const sim::SimParams::Shape& shape : p.shapes) excess_link += shape.circle.excess_link;
     std::snprintf(
         buf, sizeof buf,
-        "ibrod: %lld steps of %.4g ns on %d³, %d rod points%s, ΔLk = %d, %d threads -> %s",
+        "ibrod: %lld steps of %.4g ns on %d³, %d rod points (rods: %zu), ΔLk = %d, %d threads "
+        "-> %s",
         static_cast<long long>(sim->end_step()), sim->dt() / 1e-9, p.stepper.grid.n,
-        sim->rod().size(),
-        sim->rods().size() > 1 ? (" in " + std::to_string(sim->rods().size()) + " rods").c_str()
-                               : "",
-        p.circle.excess_link, meta.threads, dir.root().c_str());
+        sim->rod().size(), sim->rods().size(), excess_link, meta.threads, dir.root().c_str());
+  }
   say(buf);
   if (distributed)
     say("ibrod: the fluid grid is split over " + std::to_string(opt.ranks) + " MPI ranks (" +
@@ -217,7 +215,7 @@ std::string Run::State::progress_line(const sim::Observables& o) const {
 void Run::State::write_frame() {
   if (sim->params().output.frames <= 0 || !writes()) return;
   std::array<const double*, 3> u{};
-  if (c.output_fluid_vti) u = sim->stepper().whole_velocity(gathered);
+  if (c.output_fluid_vti) u = sim->system().whole_velocity(gathered);
   on_root([&] { files->frame(*sim, u); });
 }
 
@@ -251,7 +249,7 @@ void Run::State::finish(const sim::Observables& o, const std::string& stop_reaso
   const bool npy = writes() && error.empty() && stop_reason != to_string(StopReason::interrupted) &&
                    c.output_fluid_velocity;
   std::array<const double*, 3> u{};
-  if (npy) u = sim->stepper().whole_velocity(gathered);
+  if (npy) u = sim->system().whole_velocity(gathered);
   on_disk([&] {
     files->check_directory(r.steps);
     if (error.empty())
@@ -336,7 +334,7 @@ void Run::State::check_link(const sim::Observables& o) {
   if (one) {
     // (one rod: against the initial row's link, which a checkpoint keeps; a checkpoint keeps no
     // per-rod initial links)
-    if (!sim->rods()[0].closed) return;  // an open rod has no linking number to conserve
+    if (!std::isfinite(o.link)) return;  // an open rod has no linking number to conserve
     drift = std::abs(o.link - result.initial.link);
   } else {
     // several rods: each closed rod's own link (a passage between two rings changes neither)
@@ -377,7 +375,7 @@ RunResult Run::State::loop(const std::function<int()>& pending, std::int64_t max
   // the step's OpenMP loops on the run's thread count in the thread that runs them: OpenMP keeps
   // the count per thread, and the Python module may advance a run from a worker thread (where
   // the default count would sum the per-thread pair-force buffers in another order)
-  omp_set_num_threads(s.stepper().fluid_threads());
+  omp_set_num_threads(s.system().fluid_threads());
   loop_start = Clock::now();
   start_step = s.step_count();
   result.signal = 0;
@@ -519,38 +517,26 @@ InitialShapes read_initial_shapes(const config::Config& c) {
                         ", rod.rise_A = " + format_g(cr.rod_rise_A) + " Å)");
     return shape;
   };
-  if (c.rods.empty()) {
-    if (!c.rod_initial_shape.empty()) out.one = read(c, "rod.initial_shape", -1);
-    return out;
-  }
-  // several rods: each [[rods]] table's own rod.initial_shape (rod r of a file of several rods)
-  bool any = false;
-  for (int r = 0; r < config::rod_count(c); ++r) {
-    const config::Config cr = config::rod_config(c, r);
-    out.per_rod.emplace_back();
-    if (cr.rod_initial_shape.empty()) continue;
-    out.per_rod.back() = read(cr, "rods." + std::to_string(r) + ".initial_shape", r);
-    any = true;
+  // each rod's own rod.initial_shape ([[rods]] table r: rod r of a file of several rods)
+  for (const config::RodConfig& rc : config::rod_configs(c)) {
+    out.emplace_back();
+    if (!rc.keys.rod_initial_shape.empty())
+      out.back() = read(rc.keys, rc.key("initial_shape"), rc.table);
   }
   // the rods together: no two on top of each other, in the box or across its faces
-  if (config::rod_count(c) > 1) {
-    const sim::SimParams p = config::to_params(c);
-    rod::RodState whole = sim::initial_state(p);
-    if (any) {
-      const std::vector<rod::RodRange> ranges = rod::ranges_of(integrate::all_rods(p.stepper));
-      for (std::size_t r = 0; r < out.per_rod.size(); ++r) {
-        if (!out.per_rod[r]) continue;
-        for (int k = 0; k < ranges[r].n; ++k) {
-          whole.X[ranges[r].offset + k] = out.per_rod[r]->X[k];
-          whole.D[ranges[r].offset + k] = out.per_rod[r]->D[k];
-        }
-      }
+  const sim::SimParams p = config::to_params(c);
+  rod::RodState whole = sim::initial_state(p);
+  const std::vector<rod::RodRange> ranges = rod::ranges_of(p.stepper.rods);
+  for (std::size_t r = 0; r < out.size(); ++r) {
+    if (!out[r]) continue;
+    for (int k = 0; k < ranges[r].n; ++k) {
+      whole.X[ranges[r].offset + k] = out[r]->X[k];
+      whole.D[ranges[r].offset + k] = out[r]->D[k];
     }
-    if (const std::string bad =
-            sim::rods_state_problem(integrate::all_rods(p.stepper), whole, p.stepper.grid.L);
-        !bad.empty())
-      throw ConfigError("[[rods]]: the initial state: " + bad);
   }
+  if (const std::string bad = sim::rods_state_problem(p.stepper.rods, whole, p.stepper.grid.L);
+      !bad.empty())
+    throw ConfigError("rod.initial_shape: the initial state: " + bad);
   return out;
 }
 
@@ -566,9 +552,7 @@ Run::Run(const config::Config& c, const RunOptions& opt) {
   s_->restamp();
   // rod.initial_shape: read and checked before anything is written (a resumed run has its state)
   if (!opt.resume) {
-    InitialShapes shapes = read_initial_shapes(c);
-    s_->initial_shape = std::move(shapes.one);
-    s_->rod_shapes = std::move(shapes.per_rod);
+    s_->rod_shapes = read_initial_shapes(c);
   }
 }
 

@@ -4,10 +4,10 @@
 // named by io::RunDir (docs/outputs.md describes each):
 //   config.toml        the resolved configuration (every key)
 //   timeseries.csv     one row per output step (columns: timeseries_header())
-//   trajectory.h5md      H5MD trajectory: frames every output.frame_every_steps, observables, config
-//   rod.pvd, vtk/      ParaView series of the rod (.vtp), with every frame
-//   fluid.pvd          ParaView series of the fluid velocity (.vti; output.fluid_vti)
-//   checkpoint.bin     full state at the latest checkpoint (start, every
+//   trajectory.h5md      H5MD trajectory: frames every output.frame_every_steps, observables,
+//   config rod.pvd, vtk/      ParaView series of the rod (.vtp), with every frame fluid.pvd
+//   ParaView series of the fluid velocity (.vti; output.fluid_vti) checkpoint.bin     full state at
+//   the latest checkpoint (start, every
 //                      output.checkpoint_every_steps, end, SIGINT/SIGTERM)
 //   fftw.wisdom        the FFTW plans of the run (imported by --resume: same plans, same bits)
 //   final_state.csv    one row per rod point: x_A,y_A,z_A,d1x..d3z
@@ -110,15 +110,12 @@ class Run {
   std::unique_ptr<State> s_;
 };
 
-/// The initial shapes of a fresh run (rod.initial_shape; with [[rods]] each table's own), read and
-/// checked before anything is written: each shape fits its rod (sim::state_problem), and with
-/// several rods the rods' start together (the built-in shapes where no file is given) has no two
-/// rods overlapping, across the periodic box's faces too. Throws ConfigError naming the key.
-/// `ibrod check` calls it as `ibrod run` does.
-struct InitialShapes {
-  std::optional<rod::RodState> one;                   ///< one rod: rod.initial_shape, if given
-  std::vector<std::optional<rod::RodState>> per_rod;  ///< [[rods]]: each table's, or none
-};
+/// The initial shapes of a fresh run, one entry per rod (config::rod_configs): its
+/// rod.initial_shape, or none for the built-in shape. Read and checked before anything is
+/// written: each shape fits its rod (sim::state_problem), and the rods' start together (the
+/// built-in shapes where no file is given) has no two rods overlapping, across the periodic box's
+/// faces too. Throws ConfigError naming the key. `ibrod check` calls it as `ibrod run` does.
+using InitialShapes = std::vector<std::optional<rod::RodState>>;
 InitialShapes read_initial_shapes(const config::Config& c);
 
 /// Run(c, opt).execute().

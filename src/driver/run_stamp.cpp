@@ -40,15 +40,9 @@ std::vector<std::pair<std::string, std::string>> input_checksums(const config::C
     }
     out.emplace_back(key, "\"" + path + "\" crc32 " + sum);
   };
-  if (c.rods.empty()) {
-    add("rod.intrinsic_file", c.rod_intrinsic_file);
-    add("rod.moduli_file", c.rod_moduli_file);
-    return out;
-  }
-  for (int r = 0; r < config::rod_count(c); ++r) {
-    const config::Config cr = config::rod_config(c, r);
-    add("rods." + std::to_string(r) + ".intrinsic_file", cr.rod_intrinsic_file);
-    add("rods." + std::to_string(r) + ".moduli_file", cr.rod_moduli_file);
+  for (const config::RodConfig& rc : config::rod_configs(c)) {
+    add(rc.key("intrinsic_file"), rc.keys.rod_intrinsic_file);
+    add(rc.key("moduli_file"), rc.keys.rod_moduli_file);
   }
   return out;
 }

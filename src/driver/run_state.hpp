@@ -50,7 +50,7 @@ struct Run::State {
 
   std::optional<io::Checkpoint> checkpoint;  // the one to continue from, until it is applied
   bool config_changed = false;
-  bool extension = false;  // --resume with a later time.t_end_us alone
+  bool extension = false;          // --resume with a later time.t_end_us alone
   bool extended_from_end = false;  // ... of a run that had stopped at its end time
   // a run that stopped but was killed before its final files were all written: --resume only
   // writes them (the reason it stopped, from the checkpoint)
@@ -65,9 +65,8 @@ struct Run::State {
   Clock::time_point loop_start;
   std::int64_t start_step = 0;
   std::uintmax_t reserve_bytes = 0;
-  sim::Observables last_row;                   // the row of the latest output step
-  std::optional<rod::RodState> initial_shape;  // rod.initial_shape, read and checked up front
-  std::vector<std::optional<rod::RodState>> rod_shapes;  // several rods: each table's, or none
+  sim::Observables last_row;                             // the row of the latest output step
+  std::vector<std::optional<rod::RodState>> rod_shapes;  // each rod's rod.initial_shape, or none
   bool begun = false;                  // the first segment's step 0 (or the resumed row) is done
   std::vector<sim::Observables> rows;  // opt.keep_rows
 

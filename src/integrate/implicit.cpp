@@ -35,12 +35,12 @@ void unpack(const VectorXd& v, std::span<Vec3> a, std::span<Vec3> b) {
 
 }  // namespace
 
-ImplicitStepper::ImplicitStepper(Stepper& stepper, const ImplicitParams& p)
-    : st_(stepper),
+ImplicitStepper::ImplicitStepper(System& system, const ImplicitParams& p)
+    : st_(system),
       p_(p),
-      rods_(all_rods(stepper.params())),
-      ranges_(rod::ranges_of(rods_)),
-      n_(point_count(stepper.params())) {
+      rods_(system.rods()),
+      ranges_(system.ranges()),
+      n_(system.point_count()) {
   if (st_.params().distributed)
     throw std::invalid_argument("ImplicitStepper: the fluid must not be distributed");
   if (!(p_.mobility_scale >= 0)) throw std::invalid_argument("ImplicitStepper: mobility_scale < 0");
@@ -375,9 +375,9 @@ ImplicitStepInfo step_adaptive(ImplicitStepper& stepper, rod::RodState& s, Adapt
   }
 }
 
-ImplicitIntegrator::ImplicitIntegrator(Stepper& stepper, const ImplicitParams& p,
+ImplicitIntegrator::ImplicitIntegrator(System& system, const ImplicitParams& p,
                                        const AdaptiveDtParams& a)
-    : stepper_(stepper, p), ctl_(a) {}
+    : stepper_(system, p), ctl_(a) {}
 
 double ImplicitIntegrator::advance(rod::RodState& s, double max_dt) {
   double dt = 0;

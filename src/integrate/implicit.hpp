@@ -32,7 +32,7 @@
 
 #include "integrate/adaptive_dt.hpp"
 #include "integrate/block_cyclic.hpp"
-#include "integrate/stepper.hpp"
+#include "integrate/system.hpp"
 
 namespace ibrod::integrate {
 
@@ -106,13 +106,13 @@ struct ImplicitTimings {
 
 class ImplicitStepper {
  public:
-  /// Uses `stepper`'s serial fluid (not distributed), coupling and force modules; the fluid's
-  /// velocity array becomes the Stokes velocity of the latest solve. Two Stokes solves here
-  /// measure the self mobilities. Any collection of rods (all_rods(stepper.params()): closed or
-  /// open, one or several, per-link moduli): the state is all their points, K and the local
-  /// system are block-diagonal over the rods (each rod's band on its own range, block-cyclic for
-  /// a closed rod, block-tridiagonal for an open one), the steric contacts couple any two.
-  ImplicitStepper(Stepper& stepper, const ImplicitParams& p);
+  /// Steps through `system` (not owned): its serial fluid (not distributed), coupling and force
+  /// terms; the fluid's velocity array becomes the Stokes velocity of the latest solve. Two
+  /// Stokes solves here measure the self mobilities. Any collection of rods (system.rods():
+  /// closed or open, one or several, per-link moduli): the state is all their points, K and the
+  /// local system are block-diagonal over the rods (each rod's band on its own range, block-cyclic
+  /// for a closed rod, block-tridiagonal for an open one), the steric contacts couple any two.
+  ImplicitStepper(System& system, const ImplicitParams& p);
   ~ImplicitStepper();
 
   /// One implicit step of size dt (s): rod from qⁿ to qⁿ⁺¹. Returns what it did. The forces at
@@ -146,14 +146,14 @@ class ImplicitStepper {
   const StepEnergies& last_energies() const { return last_; }
   const std::vector<Vec3>& velocities() const { return U_; }          ///< [n] δX/Δt, Å s⁻¹
   const std::vector<Vec3>& angular_velocities() const { return W_; }  ///< [n] δθ/Δt, s⁻¹
-  Stepper& base() { return st_; }
+  System& system() { return st_; }
   int contacts() const { return contacts_; }
   const ImplicitTimings& timings() const {
     return timings_;
   }  ///< steric segment contacts in the latest K
 
  private:
-  Stepper& st_;
+  System& st_;  // the system (the name the overlap block of step() reads)
   ImplicitParams p_;
   std::vector<rod::RodParams> rods_;   // every rod, in the state's order
   std::vector<rod::RodRange> ranges_;  // where each lies in the state
@@ -215,23 +215,25 @@ StepOutcome outcome(const ImplicitStepInfo& info);
 /// its count of accepted steps in a row (checkpoint them with state() and put them back with
 /// restore(); K is then refreshed at the next step, so call restore() — or refresh() — at the
 /// same point of the uninterrupted run as well, e.g. whenever a checkpoint is written).
-class ImplicitIntegrator {
+class ImplicitIntegrator final : public Scheme {
  public:
   struct State {
     double next_dt = 0;  ///< s
     int accepted_in_a_row = 0;
   };
-  ImplicitIntegrator(Stepper& stepper, const ImplicitParams& p, const AdaptiveDtParams& a);
+  ImplicitIntegrator(System& system, const ImplicitParams& p, const AdaptiveDtParams& a);
 
-  /// One accepted step of at most max_dt (s; e.g. the time left to t_end): returns its Δt.
-  double advance(rod::RodState& s, double max_dt);
+  /// Scheme: one accepted step of at most max_dt (s; e.g. the time left to t_end): returns its
+  /// Δt.
+  double advance(rod::RodState& s, double max_dt) override;
+  bool adaptive() const override { return true; }
   const ImplicitStepInfo& last_info() const { return info_; }
   int last_rejections() const { return rejected_; }
   long rejections() const { return ctl_.rejections(); }
 
   State state() const { return {ctl_.dt(), ctl_.accepted_in_a_row()}; }
   void restore(const State& st);
-  void refresh() { stepper_.refresh_jacobian(); }
+  void refresh() override { stepper_.refresh_jacobian(); }
   ImplicitStepper& stepper() { return stepper_; }
   const AdaptiveDt& controller() const { return ctl_; }
 

@@ -1,6 +1,6 @@
 #pragma once
-// One time step of the generalized IB method (MODEL §4), the only place that wires the fluid, the
-// IB coupling and the rod forces together:
+// The explicit scheme: one time step of the generalized IB method (MODEL §4) through the System
+// (integrate/system.hpp: the fluid, the IB coupling and the force terms):
 //   1. rod forces at Xⁿ, Dⁿ: elastic F, T (point force/torque), + electrostatic + steric F
 //   2. PlaneCoupler::prepare: kernel weights of every point, points listed by x-plane
 //   3. FluidSolver::step(forcing, sampler): per x-plane r = ρuⁿ/Δt − ρS_h(uⁿ) + fⁿ, fⁿ = spread
@@ -17,186 +17,53 @@
 // order on every rank (DistributedFluid::sum_over_ranks: MPI_Allgather + the same additions
 // everywhere), so every rank holds bitwise the same rod state after each step. (The distributed
 // step uses the whole-grid Coupler restricted to the rank's slab, not the PlaneCoupler.)
-#include <array>
-#include <cstdint>
 #include <memory>
 #include <vector>
 
-#include "core/grid.hpp"
-#include "fluid/distributed_fluid.hpp"
-#include "fluid/navier_stokes.hpp"
-#include "ib/coupler.hpp"
-#include "ib/plane_coupler.hpp"
-#include "interactions/interactions.hpp"
-#include "rod/rod.hpp"
-#include "rod/rod_set.hpp"
+#include "integrate/system.hpp"
 
 namespace ibrod::integrate {
 
-struct StepperParams {
-  GridSpec grid;
-  int kernel_width = 1;  ///< c/h
-  fluid::FluidParams fluid;
-  rod::RodParams rod;  ///< the rod (with several rods, the first)
-  /// Several rods (`[[rods]]`, docs/model.md "Several rods"): the second, third, … rod, whose
-  /// points follow the first rod's in the state (rod::RodRange). Empty: one rod.
-  std::vector<rod::RodParams> more_rods;
-  interactions::ElectroParams electro;
-  interactions::StericParams steric;
-  int threads = 0;           ///< OpenMP/FFTW threads, 0 = OpenMP default
-  bool plan_measure = true;  ///< FFTW_MEASURE plans (slower start, faster steps)
-  /// the fluid split over the ranks of MPI_COMM_WORLD (MPI initialised; see the file comment)
-  bool distributed = false;
-  /// external load on the rod (`external.force_pN`, `external.torque_pN_nm`; docs/thermal.md):
-  /// a total force, g Å s⁻², spread evenly over the points (F/n each), its reaction −F/L³ a
-  /// uniform body force on the fluid (the fluid's mean momentum stays constant); and a torque
-  /// about the rod's centroid, g Å² s⁻², as point forces ω × (X_k − X̄) with
-  /// Σ (X_k − X̄) × (ω × (X_k − X̄)) = torque (they add no net force)
-  Vec3 external_force = Vec3::Zero();
-  Vec3 external_torque = Vec3::Zero();
-  /// with thermal noise (fluid.thermal_kT > 0): add the stochastic drift kT ∂_X·M(X) of the
-  /// overdamped limit (docs/thermal.md, "The stochastic drift"): a random finite difference of
-  /// the spreading, (kT/δ)[S(X + δW̃/2) − S(X − δW̃/2)]W̃ into the fluid, and U, W interpolated
-  /// at the midpoint Xⁿ + (Δt/2)Uⁿ⁺¹ of a predictor step
-  bool thermal_drift = false;
-};
-
-/// Every rod of p, in the state's order: p.rod, then p.more_rods.
-std::vector<rod::RodParams> all_rods(const StepperParams& p);
-/// Points of all rods together (the size of the state and of every per-point buffer).
-int point_count(const StepperParams& p);
-
-/// The potential energy of a state by term, g Å² s⁻² (Stepper::compute_forces with the forces,
-/// Stepper::energies without). The one list of the terms (terms()) that every sum of the
-/// potential energy takes: the observables' E_total, Simulation::total_energy_kT and the implicit
-/// step's energy check. A new force adds its term here (ARCHITECTURE.md "How to add a force").
-struct StepEnergies {
-  rod::ElasticEnergy elastic;
-  double electro = 0;
-  double steric = 0;
-  /// f(term) for each term, in the order every sum takes: bend, twist, stretch, electrostatic,
-  /// steric.
-  template <class F>
-  void terms(F&& f) const {
-    f(elastic.bend);
-    f(elastic.twist);
-    f(elastic.stretch);
-    f(electro);
-    f(steric);
-  }
-  /// Σ of the terms, g Å² s⁻²
-  double potential() const {
-    double e = 0;
-    terms([&](double t) { e += t; });
-    return e;
-  }
-  /// Σ of the terms each in kT (the time series' unit: the sum of its columns), kT in g Å² s⁻²
-  double potential_kT(double kT) const {
-    double e = 0;
-    terms([&](double t) { e += t / kT; });
-    return e;
-  }
-};
-
-/// The IB coupling as the fluid's plane-by-plane forcing and sampler (src/fluid knows nothing of
-/// rods): spreading into each x-plane of the right-hand side, interpolation from each x-plane of
-/// the new velocity.
-struct PlaneCouplerForcing final : fluid::PlaneForcing {
-  const ib::PlaneCoupler& coupler;
-  explicit PlaneCouplerForcing(const ib::PlaneCoupler& c) : coupler(c) {}
-  void add_plane(int i, std::array<double*, 3> plane) const override {
-    coupler.add_plane(i, plane);
-  }
-};
-struct PlaneCouplerSampler final : fluid::PlaneSampler {
-  ib::PlaneCoupler& coupler;
-  std::size_t points;  ///< sample the first `points` points only (all by default)
-  explicit PlaneCouplerSampler(ib::PlaneCoupler& c, std::size_t first = std::size_t(-1))
-      : coupler(c), points(first) {}
-  void sample_plane(int i, std::array<const double*, 3> plane) const override {
-    coupler.sample_plane(i, plane, points);
-  }
-};
-
-/// Wall time of each phase of the serial step, accumulated over the steps it is passed to
-/// (`ibrod bench`: the production step itself, timed phase by phase).
-struct StepPhaseTimes {
-  static constexpr int kCount = 8;
-  static constexpr const char* kNames[kCount] = {
-      "rod forces",   "pair forces",     "kernel weights", "rhs+spread+2D FFT",
-      "x FFTs+solve", "2D iFFT+interp.", "interp. sums",   "update"};
-  double ms[kCount] = {};
-};
-
 class PhaseClock;
 
-class Stepper {
+/// The explicit scheme (time.scheme = "explicit"): a fixed Δt (StepperParams::fluid.dt).
+class Stepper final : public Scheme {
  public:
+  /// The explicit scheme on `system` (not owned; it must outlive the Stepper).
+  explicit Stepper(System& system);
+  /// The explicit scheme on a System of its own, built from p.
   explicit Stepper(const StepperParams& p);
-  ~Stepper();
+  ~Stepper() override;
 
   /// Advance rod and fluid by one Δt. phases (serial fluid only): add each phase's wall time.
   void step(rod::RodState& s, StepPhaseTimes* phases = nullptr);
+  /// Scheme: step(s); returns the fixed Δt (max_dt is not honoured: the explicit Δt is fixed).
+  double advance(rod::RodState& s, double max_dt) override;
+  bool adaptive() const override { return false; }
 
-  /// Rod forces only (step 1): fills the point forces and torques and returns the energies.
-  StepEnergies compute_forces(const rod::RodState& s);
-  /// The energies of s without the forces (each term by its direct sum: the diagnostics' values,
-  /// O(n²) for the pair terms). Every term compute_forces() adds is here too.
-  StepEnergies energies(const rod::RodState& s) const;
-
+  System& system() { return sys_; }
+  const System& system() const { return sys_; }
   const StepperParams& params() const { return p_; }
-  /// The counter of the fluid's thermal noise (fluid::FluidSolver::set_noise_step); the
-  /// simulation sets it to its step number before each step.
-  void set_noise_step(std::uint64_t s);
-  /// The serial fluid solver (throws std::logic_error when StepperParams::distributed).
-  fluid::FluidSolver& fluid() { return *serial_fluid(); }
-  const fluid::FluidSolver& fluid() const { return *serial_fluid(); }
-
-  // The fluid, whichever it is (collective calls when StepperParams::distributed:
-  // every rank must make them in the same order).
-  /// ½ρ Σ|u|² h³ of the whole grid, g Å² s⁻² (collective; the same bits on every rank)
-  double fluid_kinetic_energy() const;
-  int fluid_threads() const;
-  /// The whole velocity (3 arrays of n³ values, GridSpec::index): the serial solver's own
-  /// arrays, or (collective) gathered into `scratch` on rank 0; nullptrs on the other ranks.
-  std::array<const double*, 3> whole_velocity(std::vector<double>& scratch) const;
-  /// Sets the fluid velocity from the whole grid (every rank passes it; collective).
-  void set_whole_velocity(std::array<const double*, 3> u);
-  ib::PlaneCoupler& plane_coupler() { return plane_coupler_; }
-  interactions::Electrostatics& electrostatics() { return electro_; }
-  interactions::Steric& steric() { return steric_; }
-  /// [n] point forces (g Å s⁻²) and torques (g Å² s⁻²) of the latest compute_forces() or step();
-  /// velocities U (Å s⁻¹) of the latest step() (the implicit scheme, issue 14, reads them)
-  const std::vector<Vec3>& forces() const { return F_; }
-  const std::vector<Vec3>& torques() const { return T_; }
+  /// velocities U (Å s⁻¹) of the latest step()
   const std::vector<Vec3>& velocities() const { return U_; }
 
  private:
-  StepperParams p_;
-  std::unique_ptr<fluid::FluidSolver> fluid_;      // serial, or
-  std::unique_ptr<fluid::DistributedFluid> dist_;  // distributed
-  ib::Coupler coupler_;
-  ib::PlaneCoupler plane_coupler_;
-  interactions::Electrostatics electro_;
-  interactions::Steric steric_;
-  rod::RodWork work_;
-  // several rods: each rod's params, range, scratch copy of its state, work and F, T buffers
-  std::vector<rod::RodParams> rods_;
-  std::vector<rod::RodRange> ranges_;
-  std::vector<rod::RodState> rod_state_;
-  std::vector<rod::RodWork> rod_work_;
-  std::vector<std::vector<Vec3>> rod_F_, rod_T_;
-  rod::ElasticEnergy elastic(const rod::RodState& s);  // F_, T_ += every rod's elastic load
-  // [n] point forces (g Å s⁻²), torques (g Å² s⁻²), velocities U (Å s⁻¹), angular
-  // velocities W (s⁻¹)
-  std::vector<Vec3> F_, T_, U_, W_;
+  Stepper(std::unique_ptr<System> own, System* shared);
+  std::unique_ptr<System> own_;  // the System when the Stepper was built from params
+  System& sys_;
+  // the system's parts the step reads, under the names the step has always used
+  const StepperParams& p_;
+  fluid::FluidSolver* fluid_;      // serial, or
+  fluid::DistributedFluid* dist_;  // distributed
+  ib::Coupler& coupler_;
+  ib::PlaneCoupler& plane_coupler_;
+  const std::vector<Vec3>& F_;  // the system's point forces and torques
+  const std::vector<Vec3>& T_;
+  // [n] velocities U (Å s⁻¹), angular velocities W (s⁻¹)
+  std::vector<Vec3> U_, W_;
   std::vector<Vec3> Xa_, Fa_, Ta_, Ua_, Wa_;  // thermal_drift: the points with the RFD pairs
   void drift_step(rod::RodState& s, PhaseClock& clock);
   std::vector<double> rank_sum_;  // distributed: [6n] U then W, packed for sum_over_ranks
-  const fluid::FluidSolver* serial_fluid() const;
-  StepEnergies forces(const rod::RodState& s, PhaseClock& clock);
-  void add_external(const std::vector<Vec3>& X);  // the external force and torque into F_
-  fluid::FluidSolver* serial_fluid();
 };
 
 }  // namespace ibrod::integrate

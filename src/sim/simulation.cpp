@@ -65,11 +65,8 @@ SimParams checked(SimParams p) {
     p.stop_kinetic = 0;
     p.stability.enabled = false;
   }
-  if (!p.stepper.more_rods.empty()) {
-    if (p.more_circles.size() != p.stepper.more_rods.size() ||
-        p.more_rotations.size() != p.stepper.more_rods.size())
-      throw std::invalid_argument("Simulation: one initial shape per rod");
-  }
+  if (p.stepper.rods.empty() || p.shapes.size() != p.stepper.rods.size())
+    throw std::invalid_argument("Simulation: one rod at least, and one initial shape per rod");
   if (p.scheme == TimeScheme::implicit_step) {
     if (p.stepper.distributed)
       throw std::invalid_argument("Simulation: the implicit scheme runs on one process only");
@@ -80,7 +77,8 @@ SimParams checked(SimParams p) {
     if (!(a.max_displacement > 0)) {
       // the pair forces stay explicit: a step moves no point by more than a fifth of the
       // shorter of their ranges (Debye length, hard-core diameter)
-      double range = p.stepper.rod.ds * 10;
+      double range = HUGE_VAL;
+      for (const rod::RodParams& r : p.stepper.rods) range = std::min(range, r.ds * 10);
       if (p.stepper.electro.enabled && p.stepper.electro.law.kappa > 0)
         range = 1 / p.stepper.electro.law.kappa;
       if (p.stepper.steric.enabled) range = std::min(range, p.stepper.steric.diameter);
@@ -94,47 +92,51 @@ SimParams checked(SimParams p) {
 }
 // One rod's initial shape: the twisted circle (closed) or the straight rod (open), turned about
 // its centroid by R.
-rod::RodState shape_of(const rod::RodParams& rp, const rod::CircleParams& c, const Mat3& R) {
+rod::RodState shape_of(const rod::RodParams& rp, const SimParams::Shape& shape) {
+  const rod::CircleParams& c = shape.circle;
   rod::RodState s =
       rp.closed ? rod::twisted_circle(rp, c) : rod::straight_rod(rp, c.perturbation, c.center);
-  if (!R.isIdentity(0)) rod::place(s, R, Vec3::Zero());
+  if (!shape.rotation.isIdentity(0)) rod::place(s, shape.rotation, Vec3::Zero());
   return s;
 }
 
 }  // namespace
 
 rod::RodState initial_state(const SimParams& p) {
-  rod::RodState s = shape_of(p.stepper.rod, p.circle, p.rotation);
-  for (std::size_t r = 0; r < p.stepper.more_rods.size(); ++r)
-    rod::append(s, shape_of(p.stepper.more_rods[r], p.more_circles[r], p.more_rotations[r]));
+  rod::RodState s;
+  for (std::size_t r = 0; r < p.stepper.rods.size(); ++r)
+    rod::append(s, shape_of(p.stepper.rods[r], p.shapes[r]));
   return s;
 }
 
 Simulation::Simulation(const SimParams& p)
-    : p_(checked(p)),
-      rods_(integrate::all_rods(p_.stepper)),
-      ranges_(rod::ranges_of(rods_)),
-      rod_(initial_state(p_)),
-      stepper_(p_.stepper) {
+    : p_(checked(p)), rod_(initial_state(p_)), system_(p_.stepper) {
+  const std::vector<rod::RodParams>& rods = this->rods();
+  const std::vector<rod::RodRange>& ranges = rod_ranges();
   // docs/thermal.md: with noise a segment's thermal stretch alone may pass 50 %
-  for (const rod::RodParams& r : rods_)
+  for (const rod::RodParams& r : rods)
     tolerances_.push_back(spacing_tolerance(r, p_.stepper.fluid.thermal_kT));
   // MODEL §6: the electrostatic energy is also reported relative to the circle at the same salt.
   // The unperturbed circle (perturbation only rotates triads, so X is the same); for an open rod
   // the straight rod.
   // Several rods: the sum of each rod's own shape alone (rods placed anywhere, even on top of
   // each other before rod.initial_shape moves them, give the same reference).
-  if (p_.stepper.electro.enabled && rods_.size() == 1)
-    electro_circle_ = stepper_.electrostatics().energy(rod_.X);
-  if (p_.stepper.electro.enabled && rods_.size() > 1) {
+  if (p_.stepper.electro.enabled && rods.size() == 1)
+    electro_circle_ = system_.electrostatics().energy(rod_.X);
+  if (p_.stepper.electro.enabled && rods.size() > 1) {
     rod::RodState one;
-    for (const rod::RodRange& g : ranges_) {
+    for (const rod::RodRange& g : ranges) {
       rod::extract(rod_, g, one);
       electro_circle_ += interactions::Electrostatics(p_.stepper.electro, g.n).energy(one.X);
     }
   }
-  if (p_.scheme == TimeScheme::implicit_step)
-    implicit_ = std::make_unique<integrate::ImplicitIntegrator>(stepper_, p_.implicit, p_.adaptive);
+  if (p_.scheme == TimeScheme::implicit_step) {
+    auto imp = std::make_unique<integrate::ImplicitIntegrator>(system_, p_.implicit, p_.adaptive);
+    implicit_ = imp.get();
+    scheme_ = std::move(imp);
+  } else {
+    scheme_ = std::make_unique<integrate::Stepper>(system_);
+  }
 }
 
 void Simulation::set_t_end(double t_end) {
@@ -144,17 +146,17 @@ void Simulation::set_t_end(double t_end) {
 }
 
 std::string Simulation::start_problem() const {
-  return rods_state_problem(rods_, rod_, p_.stepper.grid.L);
+  return rods_state_problem(rods(), rod_, p_.stepper.grid.L);
 }
 
-std::string Simulation::state_check() const { return rods_problem(rods_, rod_, tolerances_); }
+std::string Simulation::state_check() const { return rods_problem(rods(), rod_, tolerances_); }
 
 Snapshot Simulation::snapshot(bool with_velocity) const {
   Snapshot s;
   s.rod = rod_;
   if (with_velocity) {
     std::vector<double> scratch;
-    const auto u = stepper_.whole_velocity(scratch);  // collective when distributed
+    const auto u = system_.whole_velocity(scratch);  // collective when distributed
     if (u[0]) {
       const std::size_t n3 = p_.stepper.grid.size();
       s.velocity.resize(3 * n3);
@@ -175,7 +177,7 @@ void Simulation::restore(const Snapshot& s) {
                                 std::to_string(s.velocity.size()) + " values, the grid needs " +
                                 std::to_string(3 * n3));
   const double* v = s.velocity.data();
-  stepper_.set_whole_velocity({v, v + n3, v + 2 * n3});
+  system_.set_whole_velocity({v, v + n3, v + 2 * n3});
   step_ = s.step;
   time_ = s.time;
   prev_time_ = s.time;
@@ -183,10 +185,10 @@ void Simulation::restore(const Snapshot& s) {
 }
 
 void Simulation::set_rod_state(rod::RodState s, const std::string& what) {
-  if (const std::string bad = rods_state_problem(rods_, s, p_.stepper.grid.L); !bad.empty())
+  if (const std::string bad = rods_state_problem(rods(), s, p_.stepper.grid.L); !bad.empty())
     throw std::invalid_argument(what + ": " + bad);
   rod_ = std::move(s);
-  if (implicit_) implicit_->refresh();
+  scheme_->refresh();
 }
 
 namespace {
@@ -203,7 +205,7 @@ bool Simulation::due(std::int64_t steps, double every) const {
 bool Simulation::on_schedule(std::int64_t steps, double every) const {
   if (every > 0) {
     if (step_ == 0) return true;
-    if (implicit_) return std::abs(time_ / every - std::round(time_ / every)) <= 1e-9;
+    if (scheme_->adaptive()) return std::abs(time_ / every - std::round(time_ / every)) <= 1e-9;
     return multiples(time_, every) > multiples(time_ - p_.dt, every);
   }
   return steps > 0 && step_ % steps == 0;
@@ -218,20 +220,14 @@ double Simulation::time_to_next_output() const {
 
 void Simulation::step() {
   prev_time_ = time_;
-  if (implicit_) {
-    // the last step lands on t_end, and on each multiple of an output interval in simulated
-    // time (a stability probe may step beyond t_end: no cap there)
-    const double left = p_.t_end - time_;
-    double cap = left > 0 ? left : HUGE_VAL;
-    cap = std::max(std::min(cap, time_to_next_output()), p_.adaptive.dt_min);
-    time_ += implicit_->advance(rod_, cap);
-    ++step_;
-    return;
-  }
-  stepper_.set_noise_step(std::uint64_t(step_));  // the noise of step n: resumes draw alike
-  stepper_.step(rod_);
+  // an adaptive step lands on t_end, and on each multiple of an output interval in simulated
+  // time (a stability probe may step beyond t_end: no cap there); a fixed step takes its Δt
+  const double left = p_.t_end - time_;
+  double cap = left > 0 ? left : HUGE_VAL;
+  cap = std::max(std::min(cap, time_to_next_output()), p_.adaptive.dt_min);
+  system_.set_noise_step(std::uint64_t(step_));  // the noise of step n: resumes draw alike
+  time_ += scheme_->advance(rod_, cap);
   ++step_;
-  time_ += p_.dt;
 }
 
 namespace {
@@ -268,18 +264,20 @@ Observables Simulation::observe() {
   Observables o;
   o.step = step_;
   o.time_us = time() / 1e-6;
-  const integrate::StepEnergies E = stepper_.energies(rod_);
+  const integrate::StepEnergies E = system_.energies(rod_);
   o.E_bend_kT = E.elastic.bend / kT;
   o.E_twist_kT = E.elastic.twist / kT;
   o.E_stretch_kT = E.elastic.stretch / kT;
   o.E_electro_kT = E.electro / kT;
   if (p_.stepper.electro.enabled) o.dE_electro_kT = (E.electro - electro_circle_) / kT;
   o.E_steric_kT = E.steric / kT;
-  o.E_kinetic_kT = stepper_.fluid_kinetic_energy() / kT;  // collective when distributed
-  o.E_total_kT = E.potential_kT(kT) + o.E_kinetic_kT;     // the one sum (StepEnergies::terms)
+  o.E_kinetic_kT = system_.fluid_kinetic_energy() / kT;  // collective when distributed
+  o.E_total_kT = E.potential_kT(kT) + o.E_kinetic_kT;    // the one sum (StepEnergies::terms)
+  const std::vector<rod::RodParams>& rods = this->rods();
+  const std::vector<rod::RodRange>& ranges = rod_ranges();
 
-  if (rods_.size() == 1) {
-    const Topology t = topology_of(rod_, rods_[0].closed, p_.closest_min_separation);
+  if (rods.size() == 1) {
+    const Topology t = topology_of(rod_, rods[0].closed, p_.closest_min_separation);
     o.writhe = t.writhe;
     o.twist = t.twist;
     o.link = t.link;
@@ -292,9 +290,9 @@ Observables Simulation::observe() {
   double spacing = 0, closest = HUGE_VAL;
   int links = 0;
   rod::RodState one;
-  for (std::size_t r = 0; r < rods_.size(); ++r) {
-    rod::extract(rod_, ranges_[r], one);
-    const Topology t = topology_of(one, rods_[r].closed, p_.closest_min_separation);
+  for (std::size_t r = 0; r < rods.size(); ++r) {
+    rod::extract(rod_, ranges[r], one);
+    const Topology t = topology_of(one, rods[r].closed, p_.closest_min_separation);
     o.rods.push_back({t.writhe, t.twist, t.link});
     o.writhe += t.writhe;
     o.twist += t.twist;
@@ -303,26 +301,26 @@ Observables Simulation::observe() {
     spacing += t.spacing * t.links;
     links += t.links;
   }
-  for (std::size_t a = 0; a < rods_.size(); ++a)
-    for (std::size_t b = a + 1; b < rods_.size(); ++b)
-      for (int i = 0; i < ranges_[a].n; ++i)
-        for (int j = 0; j < ranges_[b].n; ++j)
-          closest = std::min(
-              closest, (rod_.X[ranges_[a].offset + i] - rod_.X[ranges_[b].offset + j]).norm());
+  for (std::size_t a = 0; a < rods.size(); ++a)
+    for (std::size_t b = a + 1; b < rods.size(); ++b)
+      for (int i = 0; i < ranges[a].n; ++i)
+        for (int j = 0; j < ranges[b].n; ++j)
+          closest = std::min(closest,
+                             (rod_.X[ranges[a].offset + i] - rod_.X[ranges[b].offset + j]).norm());
   o.closest_approach_A = closest;
   o.bp_spacing_A = links > 0 ? spacing / links : 0.0;
-  for (std::size_t a = 0; a < rods_.size(); ++a)
-    for (std::size_t b = a + 1; b < rods_.size(); ++b)
-      if (rods_[a].closed && rods_[b].closed)
+  for (std::size_t a = 0; a < rods.size(); ++a)
+    for (std::size_t b = a + 1; b < rods.size(); ++b)
+      if (rods[a].closed && rods[b].closed)
         o.pair_links.push_back(diagnostics::linking_number(
-            std::span<const Vec3>(rod_.X).subspan(ranges_[a].offset, ranges_[a].n),
-            std::span<const Vec3>(rod_.X).subspan(ranges_[b].offset, ranges_[b].n)));
+            std::span<const Vec3>(rod_.X).subspan(ranges[a].offset, ranges[a].n),
+            std::span<const Vec3>(rod_.X).subspan(ranges[b].offset, ranges[b].n)));
   return o;
 }
 
 double Simulation::total_energy_kT() {
   const double kT = p_.kT;
-  return stepper_.energies(rod_).potential_kT(kT) + stepper_.fluid_kinetic_energy() / kT;
+  return system_.energies(rod_).potential_kT(kT) + system_.fluid_kinetic_energy() / kT;
 }
 
 StopReason Simulation::stop_reason(const Observables& o) const {

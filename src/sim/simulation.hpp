@@ -1,5 +1,6 @@
 #pragma once
-// Simulation: parameters, rod state, the stepper and the diagnostics of one trajectory, and the
+// Simulation: parameters, rod state, the system and its time scheme (integrate::System, one
+// integrate::Scheme: explicit or implicit) and the diagnostics of one trajectory, and the
 // rules of its time loop: the time step Δt, the simulated time (state, advanced by each step and
 // restored from checkpoints, never recomputed as step × Δt), the output schedule (rows, frames,
 // checkpoints) and the stop rules. No I/O here (file formats live in io/, the loop that writes
@@ -13,6 +14,7 @@
 
 #include "integrate/implicit.hpp"
 #include "integrate/stepper.hpp"
+#include "integrate/system.hpp"
 #include "rod/rod.hpp"
 #include "rod/rod_set.hpp"
 #include "sim/stability.hpp"
@@ -42,14 +44,15 @@ std::string to_string(TimeScheme s);  ///< "explicit", "implicit"
 /// Everything a trajectory needs, in internal units (g, Å, s).
 struct SimParams {
   integrate::StepperParams stepper;  ///< its fluid.dt is set from dt by Simulation
-  /// The first (or only) rod's initial shape: the twisted circle (closed) or the straight rod
-  /// (open) of `circle` (its centre, link and twist perturbation), turned about its centroid by
-  /// `rotation` (rod.rotation_deg).
-  rod::CircleParams circle;
-  Mat3 rotation = Mat3::Identity();
-  /// Several rods: the same for stepper.more_rods, one each.
-  std::vector<rod::CircleParams> more_circles;
-  std::vector<Mat3> more_rotations;
+  /// A rod's initial shape: the twisted circle (closed) or the straight rod (open) of `circle`
+  /// (its centre, link and twist perturbation), turned about its centroid by `rotation`
+  /// (rod.rotation_deg).
+  struct Shape {
+    rod::CircleParams circle;
+    Mat3 rotation = Mat3::Identity();
+  };
+  /// One per rod of stepper.rods, in the same order.
+  std::vector<Shape> shapes{Shape{}};
   TimeScheme scheme = TimeScheme::explicit_step;
   /// implicit only: the scheme's knobs, and the controller's (its dt_max is set from dt; a
   /// dt_min ≤ 0 becomes 1e-3 dt, a max_displacement ≤ 0 becomes 0.2 min(1/κ, D))
@@ -127,13 +130,13 @@ class Simulation {
 
   const SimParams& params() const { return p_; }
   /// Every rod's parameters, in the state's order (one for a run of one rod).
-  const std::vector<rod::RodParams>& rods() const { return rods_; }
+  const std::vector<rod::RodParams>& rods() const { return system_.rods(); }
   /// Where each rod lies in rod() (rod::RodRange).
-  const std::vector<rod::RodRange>& rod_ranges() const { return ranges_; }
+  const std::vector<rod::RodRange>& rod_ranges() const { return system_.ranges(); }
   /// Whether every rod is closed: the collection's link and writhe are defined (sums of each
   /// rod's), so the progress lines and summary.json report them; else "not defined".
   bool all_closed() const {
-    return std::all_of(rods_.begin(), rods_.end(),
+    return std::all_of(rods().begin(), rods().end(),
                        [](const rod::RodParams& r) { return r.closed; });
   }
   /// What is wrong with the state, "" if nothing (sim::rods_problem: each rod's spacing, triads,
@@ -145,16 +148,17 @@ class Simulation {
   std::string start_problem() const;
   const rod::RodState& rod() const { return rod_; }
   rod::RodState& rod() { return rod_; }
-  integrate::Stepper& stepper() { return stepper_; }
-  const integrate::Stepper& stepper() const { return stepper_; }
+  /// The system the scheme steps through (the fluid, the coupling, the force terms).
+  integrate::System& system() { return system_; }
+  const integrate::System& system() const { return system_; }
   std::int64_t step_count() const { return step_; }
   double time() const { return time_; }  ///< simulated time, s
   double dt() const { return p_.dt; }    ///< time step, s (implicit: the largest)
   /// The Δt the next step will try (explicit: dt(); implicit: the controller's), s.
   double next_dt() const { return implicit_ ? implicit_->state().next_dt : p_.dt; }
   /// The implicit scheme (nullptr for the explicit one).
-  integrate::ImplicitIntegrator* implicit() { return implicit_.get(); }
-  const integrate::ImplicitIntegrator* implicit() const { return implicit_.get(); }
+  integrate::ImplicitIntegrator* implicit() { return implicit_; }
+  const integrate::ImplicitIntegrator* implicit() const { return implicit_; }
   /// The dynamical state (Snapshot): rod, fluid velocity (with_velocity; collective when the
   /// fluid is distributed: the whole velocity on rank 0 only), clock and the implicit scheme's
   /// controller.
@@ -167,9 +171,7 @@ class Simulation {
   /// To be called where a checkpoint is written, so that the run and its resumption refresh the
   /// implicit scheme's stiffness at the same step (resume stays bitwise). No-op for the explicit
   /// scheme.
-  void checkpoint_taken() {
-    if (implicit_) implicit_->refresh();
-  }
+  void checkpoint_taken() { scheme_->refresh(); }
   /// Moves the end of the time (t_end, s; > 0): a run continued in segments (the Python module's
   /// `run(steps=…)`, driver::Run::set_end_time). Throws std::invalid_argument if not positive.
   void set_t_end(double t_end);
@@ -189,7 +191,7 @@ class Simulation {
   /// end-of-run rule: t_end = k Δt stops after exactly k steps; steps_to_reach). Implicit: the
   /// last step lands on t_end (to round-off).
   bool at_end() const {
-    return implicit_ ? time_ >= p_.t_end * (1 - 1e-12) : time_ >= p_.t_end - 0.5 * p_.dt;
+    return scheme_->adaptive() ? time_ >= p_.t_end * (1 - 1e-12) : time_ >= p_.t_end - 0.5 * p_.dt;
   }
   /// The step at which at_end() becomes true at the present Δt (progress lines, estimates).
   std::int64_t end_step() const {
@@ -234,12 +236,11 @@ class Simulation {
   /// without one): the implicit scheme's step is capped by it.
   double time_to_next_output() const;
   SimParams p_;
-  std::vector<rod::RodParams> rods_;
-  std::vector<rod::RodRange> ranges_;
   std::vector<double> tolerances_;  ///< each rod's spacing tolerance (state_check)
   rod::RodState rod_;
-  integrate::Stepper stepper_;
-  std::unique_ptr<integrate::ImplicitIntegrator> implicit_;  // time.scheme = "implicit"
+  integrate::System system_;
+  std::unique_ptr<integrate::Scheme> scheme_;          // explicit Stepper or ImplicitIntegrator
+  integrate::ImplicitIntegrator* implicit_ = nullptr;  // scheme_, time.scheme = "implicit"
   std::int64_t step_ = 0;
   double time_ = 0;            ///< s
   double prev_time_ = 0;       ///< s, before the last step (schedules in simulated time)

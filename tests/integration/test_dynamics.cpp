@@ -90,14 +90,14 @@ TEST(Dynamics, LikeChargesPushTwoParallelLinesApart) {
   // Two parallel lines of charges with no elasticity (zero moduli): only electrostatics acts, and
   // through the fluid the lines must separate (MODEL §3 sign convention).
   auto p = config::to_params(test::small_config(0)).stepper;
-  p.rod.a.setZero();
-  p.rod.b.setZero();
+  p.rods[0].a.setZero();
+  p.rods[0].b.setZero();
   p.steric.enabled = false;
   p.electro.law.kappa = 0.05;
   p.electro.cutoff = 0;
   integrate::Stepper st(p);
   rod::RodState r;
-  const int n = p.rod.n, half = n / 2;
+  const int n = p.rods[0].n, half = n / 2;
   for (int k = 0; k < n; ++k) {
     const int line = k < half ? 0 : 1;
     const int j = line == 0 ? k : k - half;

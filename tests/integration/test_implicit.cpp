@@ -22,14 +22,14 @@ constexpr double kExplicitLimit = 0.15e-9;  // s, measured (see the file comment
 struct Ring {
   sim::SimParams p;
   rod::RodState rod;
-  std::unique_ptr<integrate::Stepper> st;
+  std::unique_ptr<integrate::System> st;
   std::unique_ptr<integrate::ImplicitStepper> imp;
   Ring(double beta, int threads = 1) {
     config::Config c = test::small_config(3);
     c.run_threads = threads;
     p = config::to_params(c);
-    rod = rod::twisted_circle(p.stepper.rod, p.circle);
-    st = std::make_unique<integrate::Stepper>(p.stepper);
+    rod = rod::twisted_circle(p.stepper.rods[0], p.shapes[0].circle);
+    st = std::make_unique<integrate::System>(p.stepper);
     integrate::ImplicitParams ip;
     ip.mobility_scale = beta;  // 0: the explicit Stokes-limit Euler step δ = Δt M F
     imp = std::make_unique<integrate::ImplicitStepper>(*st, ip);

@@ -18,7 +18,7 @@ namespace {
 struct Ring {
   sim::SimParams p;
   rod::RodState rod;
-  std::unique_ptr<integrate::Stepper> st;
+  std::unique_ptr<integrate::System> st;
   std::unique_ptr<integrate::ImplicitStepper> imp;
   explicit Ring(double beta, int order = 1, int excess_link = 3,
                 std::vector<double> perturbation = {1.0}) {
@@ -26,8 +26,8 @@ struct Ring {
     c.run_threads = 1;
     c.rod_perturbation = perturbation;
     p = config::to_params(c);
-    rod = rod::twisted_circle(p.stepper.rod, p.circle);
-    st = std::make_unique<integrate::Stepper>(p.stepper);
+    rod = rod::twisted_circle(p.stepper.rods[0], p.shapes[0].circle);
+    st = std::make_unique<integrate::System>(p.stepper);
     integrate::ImplicitParams ip;
     ip.mobility_scale = beta;  // 0: the explicit Stokes-limit Euler step δ = Δt M F
     ip.order = order;

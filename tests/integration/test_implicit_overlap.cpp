@@ -19,7 +19,7 @@ using LocalMobility = integrate::ImplicitParams::LocalMobility;
 struct Ring {
   sim::SimParams p;
   rod::RodState rod;
-  std::unique_ptr<integrate::Stepper> st;
+  std::unique_ptr<integrate::System> st;
   std::unique_ptr<integrate::ImplicitStepper> imp;
   Ring(LocalMobility mloc, double beta, int order, int excess_link,
        std::vector<double> perturbation = {1.0}, int jacobian_every = 1) {
@@ -27,8 +27,8 @@ struct Ring {
     c.run_threads = 1;
     c.rod_perturbation = perturbation;
     p = config::to_params(c);
-    rod = rod::twisted_circle(p.stepper.rod, p.circle);
-    st = std::make_unique<integrate::Stepper>(p.stepper);
+    rod = rod::twisted_circle(p.stepper.rods[0], p.shapes[0].circle);
+    st = std::make_unique<integrate::System>(p.stepper);
     integrate::ImplicitParams ip;
     ip.local_mobility = mloc;
     ip.mobility_scale = beta;  // 0: the explicit Stokes-limit Euler step δ = Δt M F

@@ -55,7 +55,7 @@ TEST(OpenRun, StraightRodWithoutIntrinsicStrainStaysStraightAndAtRest) {
   // and a closed rod in the same place would not stay: the closing link pulls the ends together
   EXPECT_GT(rod::elastic_energy(
                 [&] {
-                  rod::RodParams p = s.params().stepper.rod;
+                  rod::RodParams p = s.params().stepper.rods[0];
                   p.closed = true;
                   return p;
                 }(),

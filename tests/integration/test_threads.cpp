@@ -35,7 +35,7 @@ Trajectory run(int threads, int steps) {
   t.X0 = s.rod().X;
   for (int i = 0; i < steps; ++i) s.step();
   t.X = s.rod().X;
-  const auto& fl = s.stepper().fluid();
+  const auto& fl = s.system().fluid();
   t.threads = fl.threads();
   const std::size_t n3 = fl.grid().size();
   for (int comp = 0; comp < 3; ++comp)

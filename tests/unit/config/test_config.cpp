@@ -35,17 +35,17 @@ TEST(Config, DefaultsAreTheReferenceTableInInternalUnits) {
   EXPECT_DOUBLE_EQ(p.stepper.fluid.dt, 1e-10);
   EXPECT_NEAR(p.stepper.fluid.density, 1e-24, 1e-38);
   EXPECT_NEAR(p.stepper.fluid.viscosity, 1e-10, 1e-24);
-  EXPECT_NEAR(p.stepper.rod.a[0], 1.3e5, 1e-9);
-  EXPECT_NEAR(p.stepper.rod.a[2], 1.82e5, 1e-9);
-  EXPECT_NEAR(p.stepper.rod.b[0], 5e3, 1e-10);
-  EXPECT_NEAR(p.stepper.rod.b[2], 5e3, 1e-10);
-  EXPECT_EQ(p.stepper.rod.n, 600);
-  EXPECT_DOUBLE_EQ(p.stepper.rod.ds, 3.4);
+  EXPECT_NEAR(p.stepper.rods[0].a[0], 1.3e5, 1e-9);
+  EXPECT_NEAR(p.stepper.rods[0].a[2], 1.82e5, 1e-9);
+  EXPECT_NEAR(p.stepper.rods[0].b[0], 5e3, 1e-10);
+  EXPECT_NEAR(p.stepper.rods[0].b[2], 5e3, 1e-10);
+  EXPECT_EQ(p.stepper.rods[0].n, 600);
+  EXPECT_DOUBLE_EQ(p.stepper.rods[0].ds, 3.4);
   EXPECT_NEAR(p.kT, 414.2, 0.05);
   EXPECT_NEAR(p.stepper.electro.law.kappa, 0.10404, 1e-5);  // MODEL §1: 0.329 √0.1
-  EXPECT_EQ(p.circle.excess_link, 6);
-  ASSERT_EQ(p.circle.perturbation.size(), 1u);
-  EXPECT_EQ(p.circle.perturbation[0], 1.0);
+  EXPECT_EQ(p.shapes[0].circle.excess_link, 6);
+  ASSERT_EQ(p.shapes[0].circle.perturbation.size(), 1u);
+  EXPECT_EQ(p.shapes[0].circle.perturbation[0], 1.0);
   EXPECT_NEAR(p.stop_kinetic, 1e-12 * p.kT, 1e-20);
 }
 

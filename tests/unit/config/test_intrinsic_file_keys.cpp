@@ -49,7 +49,7 @@ TEST(IntrinsicFileKey, RowsReachTheRodInOrder) {
     text += std::to_string(0.001 * k) + ", " + std::to_string(-0.002 * k) + ",0.0436\r\n";
   const std::string path = write_file("ok.csv", text);
   const config::Config c = with_file(path, n);
-  const auto& rod = config::to_params(c).stepper.rod;
+  const rod::RodParams rod = config::to_params(c).stepper.rods[0];
   ASSERT_EQ(int(rod.omega0_k.size()), n);
   for (int k = 0; k < n; ++k) {
     EXPECT_DOUBLE_EQ(rod.omega0_k[k].x(), 0.001 * k);
@@ -58,7 +58,7 @@ TEST(IntrinsicFileKey, RowsReachTheRodInOrder) {
   }
   EXPECT_THAT(config::to_toml(c), HasSubstr("intrinsic_file = "));
   // none by default: the scalar keys apply
-  EXPECT_TRUE(config::to_params(config::Config{}).stepper.rod.omega0_k.empty());
+  EXPECT_TRUE(config::to_params(config::Config{}).stepper.rods[0].omega0_k.empty());
   std::filesystem::remove(path);
 }
 

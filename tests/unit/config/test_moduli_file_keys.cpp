@@ -56,7 +56,7 @@ TEST(ModuliFileKey, RowsReachTheRodInOrderInInternalUnits) {
     text += std::to_string(1 + k) + "e-19, 2e-19, 3e-19 , 4e-5,5e-5,\t6e-5\r\n";
   const std::string path = write_file("ok.csv", text);
   const config::Config c = with_file(path, n);
-  const auto& rod = config::to_params(c).stepper.rod;
+  const rod::RodParams rod = config::to_params(c).stepper.rods[0];
   ASSERT_EQ(int(rod.a_k.size()), n);
   ASSERT_EQ(int(rod.b_k.size()), n);
   double mean_a1 = 0;
@@ -74,8 +74,8 @@ TEST(ModuliFileKey, RowsReachTheRodInOrderInInternalUnits) {
   EXPECT_NEAR(rod.b.z(), 6e-5 * units::dyn, 1e-12 * rod.b.z());
   EXPECT_THAT(config::to_toml(c), HasSubstr("moduli_file = "));
   // none by default: the scalar keys apply
-  EXPECT_TRUE(config::to_params(config::Config{}).stepper.rod.a_k.empty());
-  EXPECT_TRUE(config::to_params(config::Config{}).stepper.rod.b_k.empty());
+  EXPECT_TRUE(config::to_params(config::Config{}).stepper.rods[0].a_k.empty());
+  EXPECT_TRUE(config::to_params(config::Config{}).stepper.rods[0].b_k.empty());
   std::filesystem::remove(path);
 }
 
@@ -86,8 +86,8 @@ TEST(ModuliFileKey, RowsOfTheScalarKeysGiveTheScalarModuliExactly) {
   config::Config scalar;
   config::apply_override(scalar, "rod.base_pairs=60");
   config::apply_override(scalar, "rod.excess_link=2");
-  const auto a = config::to_params(scalar).stepper.rod;
-  const auto b = config::to_params(with_file(path, 60)).stepper.rod;
+  const auto a = config::to_params(scalar).stepper.rods[0];
+  const auto b = config::to_params(with_file(path, 60)).stepper.rods[0];
   for (int k = 0; k < 60; ++k) {
     EXPECT_EQ(b.a_k[k], a.a);
     EXPECT_EQ(b.b_k[k], a.b);

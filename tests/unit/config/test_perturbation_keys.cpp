@@ -20,15 +20,16 @@ TEST(RandomPerturbation, IsAddedToTheDeterministicListAndRecordedInConfigToml) {
                      "test");
   const auto drawn = rod::draw_perturbation({3, 0.25, 11});
   const auto p = config::to_params(c);
-  ASSERT_EQ(p.circle.perturbation.size(), 3u);
-  EXPECT_EQ(p.circle.perturbation[0], 1.0 + drawn[0]);
-  EXPECT_EQ(p.circle.perturbation[1], drawn[1]);
-  EXPECT_EQ(p.circle.perturbation[2], drawn[2]);
+  ASSERT_EQ(p.shapes[0].circle.perturbation.size(), 3u);
+  EXPECT_EQ(p.shapes[0].circle.perturbation[0], 1.0 + drawn[0]);
+  EXPECT_EQ(p.shapes[0].circle.perturbation[1], drawn[1]);
+  EXPECT_EQ(p.shapes[0].circle.perturbation[2], drawn[2]);
   // config.toml round trip: the same ε_m
   config::Config again;
   config::apply_toml(again, config::to_toml(c), "config.toml");
   EXPECT_EQ(again.rod_perturbation_random, c.rod_perturbation_random);
-  EXPECT_EQ(config::to_params(again).circle.perturbation, p.circle.perturbation);
+  EXPECT_EQ(config::to_params(again).shapes[0].circle.perturbation,
+            p.shapes[0].circle.perturbation);
   EXPECT_THAT(config::to_toml(c),
               HasSubstr("perturbation_random = { amplitude = 0.25, modes = 3, seed = 11 }"));
   // ibrod check shows the drawn values

@@ -44,11 +44,11 @@ TEST(External, ForceAndTorqueAddTheirPointForces) {
   const std::vector<double> F{1.5, -2.0, 0.5}, tau{3.0, 1.0, -4.0};
   const sim::SimParams p0 = ring_params({0, 0, 0}, {0, 0, 0});
   const sim::SimParams p1 = ring_params(F, tau);
-  rod::RodState s = rod::twisted_circle(p0.stepper.rod, p0.circle);
+  rod::RodState s = rod::twisted_circle(p0.stepper.rods[0], p0.shapes[0].circle);
   // a generic shape: the ring tilted and bent a little
   for (int k = 0; k < s.size(); ++k)
     s.X[k] += Vec3(0.3 * std::sin(2.0 * k), 0, 2.0 * std::cos(k * 0.1));
-  Stepper a(p0.stepper), b(p1.stepper);
+  System a(p0.stepper), b(p1.stepper);
   a.compute_forces(s);
   b.compute_forces(s);
   const Vec3 c = centroid(s.X);
@@ -71,7 +71,7 @@ TEST(External, ForceAndTorqueAddTheirPointForces) {
 // Mean velocity of the centroid over `steps` steps, Å/s.
 Vec3 pulled_velocity(double fx_pN, int steps) {
   const sim::SimParams p = ring_params({fx_pN, 0, 0}, {0, 0, 0});
-  rod::RodState s = rod::twisted_circle(p.stepper.rod, p.circle);
+  rod::RodState s = rod::twisted_circle(p.stepper.rods[0], p.shapes[0].circle);
   Stepper st(p.stepper);
   const Vec3 c0 = centroid(s.X);
   for (int i = 0; i < steps; ++i) st.step(s);
@@ -79,7 +79,7 @@ Vec3 pulled_velocity(double fx_pN, int steps) {
   for (int c = 0; c < 3; ++c) {
     double mean = 0;
     const std::size_t n3 = p.stepper.grid.size();
-    for (std::size_t t = 0; t < n3; ++t) mean += st.fluid().velocity(c)[t];
+    for (std::size_t t = 0; t < n3; ++t) mean += st.system().fluid().velocity(c)[t];
     EXPECT_LT(std::abs(mean / double(n3)), 1.0) << "component " << c;  // Å/s; the ring: ~1e10
   }
   return (centroid(s.X) - c0) / (steps * p.dt);
@@ -131,7 +131,7 @@ TEST(External, ImplicitSchemePullsTheRingAtTheExplicitVelocity) {
   (void)c0;
   // the explicit scheme's steady velocity, after 10 steps of start-up
   const sim::SimParams p = ring_params({1.0, 0, 0}, {0, 0, 0});
-  rod::RodState r = rod::twisted_circle(p.stepper.rod, p.circle);
+  rod::RodState r = rod::twisted_circle(p.stepper.rods[0], p.shapes[0].circle);
   Stepper st(p.stepper);
   for (int i = 0; i < 10; ++i) st.step(r);
   const Vec3 e0 = centroid(r.X);
@@ -148,8 +148,8 @@ TEST(External, ImplicitSchemePullsTheRingAtTheExplicitVelocity) {
 // √(2 kT M_self Δt).
 TEST(ThermalDrift, DivergenceOfTheMobilityIsSmallAgainstTheNoise) {
   const sim::SimParams p = ring_params({0, 0, 0}, {0, 0, 0});
-  rod::RodState s = rod::twisted_circle(p.stepper.rod, p.circle);
-  Stepper st(p.stepper);
+  rod::RodState s = rod::twisted_circle(p.stepper.rods[0], p.shapes[0].circle);
+  System st(p.stepper);
   ImplicitStepper imp(st, ImplicitParams{});
   const int n = s.size();
   const double delta = 0.01;  // Å; the kernel varies on the scale h = 12.5 Å
@@ -195,10 +195,10 @@ TEST(ThermalDrift, TheAddedDriftIsKTTimesTheDivergenceOfTheMobility) {
   sim::SimParams p = ring_params({0, 0, 0}, {0, 0, 0});
   p.stepper.electro.enabled = false;  // the twisted circle is then at rest without noise
   p.stepper.steric.enabled = false;
-  const rod::RodState s0 = rod::twisted_circle(p.stepper.rod, p.circle);
+  const rod::RodState s0 = rod::twisted_circle(p.stepper.rods[0], p.shapes[0].circle);
   const int n = s0.size();
   // kT ∂·M by central differences (as in the test above)
-  Stepper st0(p.stepper);
+  System st0(p.stepper);
   ImplicitStepper imp(st0, ImplicitParams{});
   const double delta = 0.01;
   std::vector<Vec3> F(n, Vec3::Zero()), T(n, Vec3::Zero()), Up(n), Um(n), W(n);
@@ -226,8 +226,8 @@ TEST(ThermalDrift, TheAddedDriftIsKTTimesTheDivergenceOfTheMobility) {
   for (int i = 0; i < samples; ++i) {
     rod::RodState sa = s0, sb = s0;
     for (Stepper* x : {&a, &b}) {
-      for (int c = 0; c < 3; ++c) std::fill_n(x->fluid().velocity(c), cells, 0.0);
-      x->set_noise_step(std::uint64_t(1000 + i));
+      for (int c = 0; c < 3; ++c) std::fill_n(x->system().fluid().velocity(c), cells, 0.0);
+      x->system().set_noise_step(std::uint64_t(1000 + i));
     }
     a.step(sa);
     b.step(sb);

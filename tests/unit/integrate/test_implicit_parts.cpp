@@ -20,7 +20,7 @@ namespace {
 struct Ring {
   sim::SimParams p;
   rod::RodState rod;
-  std::unique_ptr<Stepper> st;
+  std::unique_ptr<System> st;
   explicit Ring(int excess_link = 2, bool per_link_moduli = false) {
     config::Config c;
     c.grid_n = 16;
@@ -32,7 +32,7 @@ struct Ring {
     p = config::to_params(c);
     if (per_link_moduli) {
       // rod.moduli_file's RodParams: each modulus of each link a factor 1/3 to 3 of the scalar
-      rod::RodParams& r = p.stepper.rod;
+      rod::RodParams& r = p.stepper.rods[0];
       std::mt19937_64 g(23);
       std::uniform_real_distribution<double> f(std::log(1.0 / 3), std::log(3.0));
       r.a_k.resize(r.n);
@@ -43,7 +43,7 @@ struct Ring {
           r.b_k[k][i] = r.b[i] * std::exp(f(g));
         }
     }
-    rod = rod::twisted_circle(p.stepper.rod, p.circle);
+    rod = rod::twisted_circle(p.stepper.rods[0], p.shapes[0].circle);
     // a generic, strained state: random displacements (0.3 Å) and rotations (0.05 rad)
     std::mt19937_64 rng(11);
     std::normal_distribution<double> N(0, 1);
@@ -51,7 +51,7 @@ struct Ring {
       rod.X[k] += 0.3 * Vec3(N(rng), N(rng), N(rng));
       rod.D[k] = rotation(0.05 * Vec3(N(rng), N(rng), N(rng))) * rod.D[k];
     }
-    st = std::make_unique<Stepper>(p.stepper);
+    st = std::make_unique<System>(p.stepper);
   }
 };
 
@@ -160,7 +160,7 @@ TEST(ImplicitStepper, UndoRestoresTheStateAndTheEnergyBookkeeping) {
 struct Rods {
   sim::SimParams p;
   rod::RodState rod;
-  std::unique_ptr<Stepper> st;
+  std::unique_ptr<System> st;
   explicit Rods(const config::Config& c) {
     p = config::to_params(c);
     rod = sim::initial_state(p);
@@ -170,7 +170,7 @@ struct Rods {
       rod.X[k] += 0.3 * Vec3(N(rng), N(rng), N(rng));
       rod.D[k] = rotation(0.05 * Vec3(N(rng), N(rng), N(rng))) * rod.D[k];
     }
-    st = std::make_unique<Stepper>(p.stepper);
+    st = std::make_unique<System>(p.stepper);
   }
 };
 
@@ -229,7 +229,7 @@ TEST(ImplicitStiffness, OpenRodHasNoLinkPastItsEnds) {
 
 TEST(ImplicitStiffness, SeveralRodsAreBlockDiagonalEachRodAlone) {
   Rods both(ring_and_open_rod());
-  const std::vector<rod::RodRange> g = rod::ranges_of(all_rods(both.p.stepper));
+  const std::vector<rod::RodRange> g = rod::ranges_of(both.p.stepper.rods);
   ASSERT_EQ(g.size(), 2u);
   for (const bool fd : {false, true}) {
     const Eigen::MatrixXd K = dense_K(both, fd);

@@ -102,7 +102,7 @@ TEST(SeveralRods, BadTablesNameTheTableAndKey) {
 
 TEST(SeveralRods, ElasticForcesAreEachRodsOwn) {
   const sim::SimParams p = config::to_params(two_rings());
-  ASSERT_EQ(p.stepper.more_rods.size(), 1u);
+  ASSERT_EQ(p.stepper.rods.size(), 2u);
   sim::Simulation sim(p);
   rod::RodState s = sim.rod();
   std::mt19937_64 rng(3);
@@ -111,11 +111,11 @@ TEST(SeveralRods, ElasticForcesAreEachRodsOwn) {
   StepperParams sp = p.stepper;
   sp.electro.enabled = false;
   sp.steric.enabled = false;
-  Stepper st(sp);
+  System st(sp);
   const StepEnergies e = st.compute_forces(s);
   double sum = 0;
-  const auto ranges = rod::ranges_of(all_rods(sp));
-  const auto rods = all_rods(sp);
+  const auto ranges = rod::ranges_of(sp.rods);
+  const auto rods = sp.rods;
   for (std::size_t r = 0; r < rods.size(); ++r) {
     rod::RodState one;
     rod::extract(s, ranges[r], one);
@@ -137,11 +137,11 @@ TEST(SeveralRods, PairForcesObeyNewtonsThirdLawAndAreMinusGradient) {
   const auto ranges = sim.rod_ranges();
   // pair forces only: elastic off (zero moduli would be refused; take them out by difference)
   StepperParams sp = p.stepper;
-  Stepper all(sp);
+  System all(sp);
   StepperParams el = sp;
   el.electro.enabled = false;
   el.steric.enabled = false;
-  Stepper elastic_only(el);
+  System elastic_only(el);
   const StepEnergies e = all.compute_forces(s);
   elastic_only.compute_forces(s);
   ASSERT_GT(e.steric, 0.0) << "the rings must overlap within the hard core";
@@ -152,9 +152,8 @@ TEST(SeveralRods, PairForcesObeyNewtonsThirdLawAndAreMinusGradient) {
     rod::RodState one;
     rod::extract(s, ranges[r], one);
     StepperParams alone = sp;
-    alone.rod = all_rods(sp)[r];
-    alone.more_rods.clear();
-    Stepper a(alone);
+    alone.rods = {sp.rods[r]};
+    System a(alone);
     a.compute_forces(one);
     for (int k = 0; k < one.size(); ++k) {
       const int i = ranges[r].offset + k;
@@ -172,7 +171,7 @@ TEST(SeveralRods, PairForcesObeyNewtonsThirdLawAndAreMinusGradient) {
   EXPECT_LT(on[0][2], 0.0);
   // F = −∇E of electro + steric + elastic by central differences, for points of both rods
   auto energy = [&](const rod::RodState& x) {
-    Stepper t(sp);
+    System t(sp);
     const StepEnergies en = t.compute_forces(x);
     return en.elastic.total() + en.electro + en.steric;
   };

@@ -71,14 +71,14 @@ TEST(PotentialEnergy, OneSumForObservablesTotalEnergyAndTheStepper) {
     for (int k = 0; k < 20; ++k) s.step();
     const Observables o = s.observe();
     const double kT = s.params().kT;
-    const integrate::StepEnergies E = s.stepper().energies(s.rod());
+    const integrate::StepEnergies E = s.system().energies(s.rod());
     EXPECT_EQ(o.E_total_kT, s.total_energy_kT());
     EXPECT_EQ(o.E_total_kT, E.potential_kT(kT) + o.E_kinetic_kT);
     EXPECT_EQ(o.E_bend_kT + o.E_twist_kT + o.E_stretch_kT + o.E_electro_kT + o.E_steric_kT +
                   o.E_kinetic_kT,
               o.E_total_kT);
     // the forces' energies (cell lists) are the same terms to round-off
-    const integrate::StepEnergies F = s.stepper().compute_forces(s.rod());
+    const integrate::StepEnergies F = s.system().compute_forces(s.rod());
     EXPECT_NEAR(F.potential(), E.potential(), 1e-12 * std::abs(E.potential()));
     double sum = 0;
     E.terms([&](double t) { sum += t; });
