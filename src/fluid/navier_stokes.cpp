@@ -542,9 +542,12 @@ void FluidSolver::solve_slice_stokes(int j) {
   }
 }
 
-void FluidSolver::solve_stokes(const PlaneForcing& forcing, const PlaneSampler* sampler) {
+void FluidSolver::solve_stokes(const PlaneForcing& forcing, const PlaneSampler* sampler,
+                               bool thermal) {
   if (!(params_.viscosity > 0.0))
     throw std::logic_error("FluidSolver::solve_stokes: needs a viscosity > 0");
+  if (thermal && !(params_.thermal_kT > 0.0 && params_.dt > 0.0))
+    throw std::logic_error("FluidSolver::solve_stokes: thermal needs thermal_kT > 0 and dt > 0");
   if (!force_zero_)
     throw std::logic_error("FluidSolver::solve_stokes: force() must be zero (it was written)");
   const int n = grid_.n;
@@ -565,6 +568,7 @@ void FluidSolver::solve_stokes(const PlaneForcing& forcing, const PlaneSampler* 
     const int par = (j * nzh) % 2;
     fftw_complex* slice = base + std::size_t(j) * nzh;
     fftw_execute_dft(as_plan(plan_x_fwd_[par]), slice, slice);
+    if (thermal) add_noise_slice(j);  // the random stress, as in step(): ξ̂ on this slice
     solve_slice_stokes(j);
     fftw_execute_dft(as_plan(plan_x_bwd_[par]), slice, slice);
   }

@@ -137,7 +137,15 @@ class FluidSolver {
   ///   û = P(k) f̂ / (−μ L̂(k)) for k ≠ 0,  û(0) = 0.
   /// force() must be zero (it is after every step). The same fused plane and slice passes as
   /// step(), with `sampler` (if given) reading each plane of u as it is made. No allocation.
-  void solve_stokes(const PlaneForcing& forcing, const PlaneSampler* sampler = nullptr);
+  /// `thermal` (issue 28; needs FluidParams::thermal_kT > 0): the random stress of
+  /// add_noise_slice, keyed by (seed, noise_step(), mode) as in step(), is added to f̂ in the same
+  /// solve, so that u = (−μL_h)⁻¹P(f + ξ): its Brownian part has the covariance
+  /// (2kT/Δt) G, G the Stokes response to a unit point force, and an interpolated J u the
+  /// covariance (2kT/Δt) M — the Stokes-limit increment √(2kTΔt) M^{1/2} W per step Δt =
+  /// FluidParams::dt, at no extra solve (docs/thermal.md, "Noise in the implicit scheme"). The
+  /// counter is not advanced: the caller sets it (set_noise_step) for each step's draw.
+  void solve_stokes(const PlaneForcing& forcing, const PlaneSampler* sampler = nullptr,
+                    bool thermal = false);
 
   /// Fluid kinetic energy ½ρ Σ|u|² h³, g Å² s⁻².
   double kinetic_energy() const;

@@ -256,5 +256,56 @@ TEST(ThermalDrift, TheAddedDriftIsKTTimesTheDivergenceOfTheMobility) {
   for (int k = 0; k < n; ++k) EXPECT_EQ(sc.X[k], sd.X[k]) << k;
 }
 
+// Issue 28: the drift must not change the centroid's thermal motion (∂·M of the centroid is zero
+// by translation invariance, and the force pairs of the random finite difference add no net
+// force). One step of the ring from the same stationary fluid and the same noise, with and
+// without the drift: the centroid's mean displacement difference is zero within its standard
+// error, and its per-step variance the same within 2 % (a drift that halved or doubled the
+// centroid's noise, or pushed it, fails).
+TEST(ThermalDrift, TheCentroidsOneStepStatisticsAreThoseWithoutTheDrift) {
+  sim::SimParams p = ring_params({0, 0, 0}, {0, 0, 0});
+  p.stepper.electro.enabled = false;
+  p.stepper.steric.enabled = false;
+  const rod::RodState s0 = rod::twisted_circle(p.stepper.rod, p.circle);
+  StepperParams with = p.stepper, without = p.stepper;
+  with.fluid.thermal_kT = without.fluid.thermal_kT = p.kT;
+  with.thermal_drift = true;
+  without.thermal_drift = false;
+  Stepper a(with), b(without);
+  const std::size_t cells = std::size_t(p.stepper.grid.n) * p.stepper.grid.n * p.stepper.grid.n;
+  std::vector<double> u(3 * cells);
+  // a stationary fluid: the ring held at s0, 40 steps of burn-in
+  for (int i = 0; i < 40; ++i) {
+    rod::RodState sb = s0;
+    b.set_noise_step(std::uint64_t(i));
+    b.step(sb);
+  }
+  const int samples = 1500;
+  Vec3 mean_diff = Vec3::Zero();
+  double sum2_diff = 0, var_a = 0, var_b = 0;
+  for (int i = 0; i < samples; ++i) {
+    for (int c = 0; c < 3; ++c) std::copy_n(b.fluid().velocity(c), cells, u.data() + c * cells);
+    for (int c = 0; c < 3; ++c) std::copy_n(u.data() + c * cells, cells, a.fluid().velocity(c));
+    rod::RodState sa = s0, sb = s0;
+    a.set_noise_step(std::uint64_t(100 + i));
+    b.set_noise_step(std::uint64_t(100 + i));
+    a.step(sa);
+    b.step(sb);  // b's fluid carries on: the next sample starts from it
+    const Vec3 da = centroid(sa.X) - centroid(s0.X), db = centroid(sb.X) - centroid(s0.X);
+    mean_diff += (da - db) / double(samples);
+    sum2_diff += (da - db).squaredNorm();
+    var_a += da.squaredNorm();
+    var_b += db.squaredNorm();
+  }
+  const double se = std::sqrt(sum2_diff / samples / samples);  // per component, roughly
+  const double ratio = var_a / var_b;
+  std::printf(
+      "ThermalDrift: centroid per step: mean(with − without) = (%.3g, %.3g, %.3g) Å, "
+      "standard error %.3g Å; variance with / without = %.4f (rms step %.3g Å)\n",
+      mean_diff.x(), mean_diff.y(), mean_diff.z(), se, ratio, std::sqrt(var_b / samples));
+  EXPECT_LT(mean_diff.norm(), 5 * se + 1e-12);
+  EXPECT_NEAR(ratio, 1.0, 0.02);
+}
+
 }  // namespace
 }  // namespace ibrod::integrate
