@@ -266,7 +266,7 @@ TEST(ThermalDrift, TheCentroidsOneStepStatisticsAreThoseWithoutTheDrift) {
   sim::SimParams p = ring_params({0, 0, 0}, {0, 0, 0});
   p.stepper.electro.enabled = false;
   p.stepper.steric.enabled = false;
-  const rod::RodState s0 = rod::twisted_circle(p.stepper.rod, p.circle);
+  const rod::RodState s0 = rod::twisted_circle(p.stepper.rods[0], p.shapes[0].circle);
   StepperParams with = p.stepper, without = p.stepper;
   with.fluid.thermal_kT = without.fluid.thermal_kT = p.kT;
   with.thermal_drift = true;
@@ -277,18 +277,18 @@ TEST(ThermalDrift, TheCentroidsOneStepStatisticsAreThoseWithoutTheDrift) {
   // a stationary fluid: the ring held at s0, 40 steps of burn-in
   for (int i = 0; i < 40; ++i) {
     rod::RodState sb = s0;
-    b.set_noise_step(std::uint64_t(i));
+    b.system().set_noise_step(std::uint64_t(i));
     b.step(sb);
   }
   const int samples = 1500;
   Vec3 mean_diff = Vec3::Zero();
   double sum2_diff = 0, var_a = 0, var_b = 0;
   for (int i = 0; i < samples; ++i) {
-    for (int c = 0; c < 3; ++c) std::copy_n(b.fluid().velocity(c), cells, u.data() + c * cells);
-    for (int c = 0; c < 3; ++c) std::copy_n(u.data() + c * cells, cells, a.fluid().velocity(c));
+    for (int c = 0; c < 3; ++c) std::copy_n(b.system().fluid().velocity(c), cells, u.data() + c * cells);
+    for (int c = 0; c < 3; ++c) std::copy_n(u.data() + c * cells, cells, a.system().fluid().velocity(c));
     rod::RodState sa = s0, sb = s0;
-    a.set_noise_step(std::uint64_t(100 + i));
-    b.set_noise_step(std::uint64_t(100 + i));
+    a.system().set_noise_step(std::uint64_t(100 + i));
+    b.system().set_noise_step(std::uint64_t(100 + i));
     a.step(sa);
     b.step(sb);  // b's fluid carries on: the next sample starts from it
     const Vec3 da = centroid(sa.X) - centroid(s0.X), db = centroid(sb.X) - centroid(s0.X);
