@@ -104,9 +104,10 @@ int main(int argc, char** argv) {
     const double ta = time_ms([&] { lu.analyzePattern(A); });
     const double tf = time_ms([&] { lu.factorize(A); });
     const double ts = time_ms([&] { x = lu.solve(v); });
-    std::printf("SparseLU natural, symmetric mode, diagonal pivots: analyze %.2f factorize %.2f "
-                "solve %.3f ms, residual %.2e\n",
-                ta, tf, ts, (A * x - v).norm() / v.norm());
+    std::printf(
+        "SparseLU natural, symmetric mode, diagonal pivots: analyze %.2f factorize %.2f "
+        "solve %.3f ms, residual %.2e\n",
+        ta, tf, ts, (A * x - v).norm() / v.norm());
   }
   // matrix-free application of A (for iterative refinement against a kept factorisation)
   const double tm = time_ms([&] { x = v + dt * (O * (K * v)); }, 10);

@@ -30,7 +30,8 @@ struct SchemeBenchResult {
 /// as configured), both from the configured initial state.
 SchemeBenchResult bench_schemes(const config::Config& c, int explicit_steps, double implicit_dt_ns,
                                 double implicit_ns);
-/// Prints the two and the implicit step's parts; the last line is `us_per_hour_explicit=… us_per_hour_implicit=…`.
+/// Prints the two and the implicit step's parts; the last line is `us_per_hour_explicit=…
+/// us_per_hour_implicit=…`.
 void print_bench_schemes(const SchemeBenchResult& r, std::FILE* out);
 
 }  // namespace ibrod::driver

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <memory>
 #include <stdexcept>
@@ -468,11 +470,22 @@ RunResult Run::State::loop(const std::function<int()>& pending, std::int64_t max
       progress.finish_line();
       throw;
     }
+    // a write that failed because the run directory was deleted or moved under the run (finish
+    // notices a directory that is gone; a file of the run's that vanished mid-write, ENOENT, means
+    // the deletion was under way): that is the cause to report, with no --resume advice
+    std::string gone;
+    if (writes() && what.rfind("output: ", 0) == 0 &&
+        what.find(dir.root().string()) != std::string::npos &&
+        what.find(std::strerror(ENOENT)) != std::string::npos)
+      gone = RunFiles::directory_gone(dir.root(), sim->step_count());
     try {
       finish(last_row, to_string(StopReason::error), what);
-    } catch (const RunError&) {
+    } catch (const RunError& f) {
+      if (std::string(f.what()).find(" was deleted or moved while the run") != std::string::npos)
+        gone = f.what();
     }
     progress.finish_line();
+    if (!gone.empty()) throw RunError(gone);
     // the advice that works: --resume needs a checkpoint
     if (!writes()) throw;
     if (what.find("--resume") != std::string::npos || what.find("--overwrite") != std::string::npos)

@@ -145,12 +145,17 @@ class RunFiles {
   void check_directory(std::int64_t step) const {
     struct stat st {};
     if (::stat(dir_.root().c_str(), &st) == 0 && st.st_dev == dev_ && st.st_ino == ino_) return;
-    throw RunError("output: the run directory " + dir_.root().string() +
-                   " was deleted or moved while the run was writing it (noticed at step " +
-                   std::to_string(step) +
-                   "); the run stops here rather than write where nobody would find it. If it "
-                   "was moved, continue it where it is now with --resume NEWDIR; if it was "
-                   "deleted, there is no checkpoint left to --resume from: start the run again");
+    throw RunError(directory_gone(dir_.root(), step));
+  }
+  /// The message of check_directory (also for a write that failed while the directory was being
+  /// deleted, before it was gone).
+  static std::string directory_gone(const std::filesystem::path& root, std::int64_t step) {
+    return "output: the run directory " + root.string() +
+           " was deleted or moved while the run was writing it (noticed at step " +
+           std::to_string(step) +
+           "); the run stops here rather than write where nobody would find it. If it "
+           "was moved, continue it where it is now with --resume NEWDIR; if it was "
+           "deleted, there is no checkpoint left to --resume from: start the run again";
   }
 
   void row(const sim::Observables& o) {

@@ -36,11 +36,7 @@ void unpack(const VectorXd& v, std::span<Vec3> a, std::span<Vec3> b) {
 }  // namespace
 
 ImplicitStepper::ImplicitStepper(System& system, const ImplicitParams& p)
-    : st_(system),
-      p_(p),
-      rods_(system.rods()),
-      ranges_(system.ranges()),
-      n_(system.point_count()) {
+    : st_(system), p_(p), rods_(system.rods()), ranges_(system.ranges()), n_(system.point_count()) {
   if (st_.params().distributed)
     throw std::invalid_argument("ImplicitStepper: the fluid must not be distributed");
   if (!(p_.mobility_scale >= 0)) throw std::invalid_argument("ImplicitStepper: mobility_scale < 0");

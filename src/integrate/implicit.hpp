@@ -99,8 +99,8 @@ struct ImplicitStepInfo {
 /// Wall time spent in the parts of ImplicitStepper::step, accumulated, s.
 struct ImplicitTimings {
   double forces = 0, stiffness = 0, factorize = 0, local_solve = 0, stokes = 0;
-  double overlap = 0;  ///< building M_loc = β D O D (in stiffness too)
-  double analyze = 0;  ///< the LU's pattern analysis (in factorize too)
+  double overlap = 0;       ///< building M_loc = β D O D (in stiffness too)
+  double analyze = 0;       ///< the LU's pattern analysis (in factorize too)
   long factorizations = 0;  ///< of the local system (count)
 };
 

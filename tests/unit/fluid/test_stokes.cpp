@@ -198,8 +198,8 @@ TEST(Stokes, ThermalNoiseHasTheCovarianceOfTheStokesResponse) {
   struct Pair {
     int c, d, di, dj;
   };
-  const std::vector<Pair> pairs = {{0, 0, 0, 0}, {1, 1, 0, 0}, {2, 2, 0, 0}, {0, 1, 1, 1},
-                                   {0, 0, 1, 1}, {2, 2, 1, 1}};
+  const std::vector<Pair> pairs = {{0, 0, 0, 0}, {1, 1, 0, 0}, {2, 2, 0, 0},
+                                   {0, 1, 1, 1}, {0, 0, 1, 1}, {2, 2, 1, 1}};
   std::vector<double> cov(pairs.size(), 0.0);
   const int samples = 300;
   double max_div = 0, max_mean = 0;
@@ -214,8 +214,7 @@ TEST(Stokes, ThermalNoiseHasTheCovarianceOfTheStokesResponse) {
       for (int i = 0; i < g.n; ++i)
         for (int j = 0; j < g.n; ++j)
           for (int k = 0; k < g.n; ++k)
-            acc += uc[g.index(i, j, k)] *
-                   ud[g.index((i + pr.di) % g.n, (j + pr.dj) % g.n, k)];
+            acc += uc[g.index(i, j, k)] * ud[g.index((i + pr.di) % g.n, (j + pr.dj) % g.n, k)];
       cov[q] += acc / double(n3) / samples;
     }
     max_div = std::max(max_div, fl.max_divergence());

@@ -284,8 +284,10 @@ TEST(ThermalDrift, TheCentroidsOneStepStatisticsAreThoseWithoutTheDrift) {
   Vec3 mean_diff = Vec3::Zero();
   double sum2_diff = 0, var_a = 0, var_b = 0;
   for (int i = 0; i < samples; ++i) {
-    for (int c = 0; c < 3; ++c) std::copy_n(b.system().fluid().velocity(c), cells, u.data() + c * cells);
-    for (int c = 0; c < 3; ++c) std::copy_n(u.data() + c * cells, cells, a.system().fluid().velocity(c));
+    for (int c = 0; c < 3; ++c)
+      std::copy_n(b.system().fluid().velocity(c), cells, u.data() + c * cells);
+    for (int c = 0; c < 3; ++c)
+      std::copy_n(u.data() + c * cells, cells, a.system().fluid().velocity(c));
     rod::RodState sa = s0, sb = s0;
     a.system().set_noise_step(std::uint64_t(100 + i));
     b.system().set_noise_step(std::uint64_t(100 + i));
