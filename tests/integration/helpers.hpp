@@ -3,6 +3,8 @@
 // box on a 16³ grid (h = 12.5 Å, close to the reference 11.3 Å), so that a run of a few thousand
 // steps takes seconds. Tests that start the real binary write it with config::to_toml after
 // changing what they need.
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "config/config.hpp"
@@ -24,5 +26,13 @@ inline config::Config small_config(int excess_link) {
 
 /// small_config as the TOML document `ibrod run CONFIG` reads.
 inline std::string small_config_toml(const config::Config& c) { return config::to_toml(c); }
+
+/// Writes c (as small_config_toml) to d/name; returns that path.
+inline std::filesystem::path write_config(const std::filesystem::path& d, const config::Config& c,
+                                          const std::string& name) {
+  const std::filesystem::path p = d / name;
+  std::ofstream(p) << small_config_toml(c);
+  return p;
+}
 
 }  // namespace ibrod::test

@@ -39,12 +39,6 @@ config::Config long_config() {
   return c;
 }
 
-fs::path write_config(const fs::path& d, const config::Config& c, const std::string& name) {
-  const fs::path p = d / name;
-  std::ofstream(p) << small_config_toml(c);
-  return p;
-}
-
 std::vector<double> column(const fs::path& csv, const std::string& name) {
   const io::CsvTable t = io::read_csv_table(csv);
   const auto s = t.column(name);

@@ -41,12 +41,6 @@ config::Config short_config() {
   return c;
 }
 
-fs::path write_config(const fs::path& d, const config::Config& c, const std::string& name) {
-  const fs::path p = d / name;
-  std::ofstream(p) << small_config_toml(c);
-  return p;
-}
-
 // A finished run of c in d/name.
 fs::path finished_run(const fs::path& d, const config::Config& c, const std::string& name) {
   const fs::path cfg = write_config(d, c, name + ".toml");

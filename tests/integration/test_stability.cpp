@@ -25,21 +25,27 @@ using ::testing::HasSubstr;
 
 namespace {
 
-// 16³, 100 points, no perturbation, a loose stop rule (E_K < 1e-8 kT fires after ~200 steps),
-// a 0.2 µs probe
-fs::path circle_config(const fs::path& d, int excess_link) {
+// small_config with the equilibrium rule at stop_kT, a probe of probe_us, rows every 100 steps
+// (rows in simulated time for the implicit scheme: set output_every_us), no frames or periodic
+// checkpoints, one thread
+config::Config stop_rule_config(int excess_link, double stop_kT, double probe_us) {
   config::Config c = small_config(excess_link);
-  c.rod_perturbation = {0.0};
-  c.time_t_end_us = 0.5;
-  c.time_stop_kinetic_kT = 1e-8;
-  c.time_stability_probe_us = 0.2;
+  c.time_stop_kinetic_kT = stop_kT;
+  c.time_stability_probe_us = probe_us;
   c.output_every_steps = 100;
   c.output_frame_every_steps = 0;
   c.output_checkpoint_every_steps = 0;
   c.run_threads = 1;
-  const fs::path p = d / ("dlk" + std::to_string(excess_link) + ".toml");
-  std::ofstream(p) << small_config_toml(c);
-  return p;
+  return c;
+}
+
+// 16³, 100 points, no perturbation, a loose stop rule (E_K < 1e-8 kT fires after ~200 steps),
+// a 0.2 µs probe
+fs::path circle_config(const fs::path& d, int excess_link) {
+  config::Config c = stop_rule_config(excess_link, 1e-8, 0.2);
+  c.rod_perturbation = {0.0};
+  c.time_t_end_us = 0.5;
+  return write_config(d, c, "dlk" + std::to_string(excess_link) + ".toml");
 }
 
 double final_writhe(const fs::path& out) {
@@ -51,22 +57,14 @@ double final_writhe(const fs::path& out) {
 // uncharged (so that only the fluid couples them and the pair comes to rest), with ΔLk = dlk0
 // and dlk1; the stop rule and probe of circle_config.
 fs::path two_rings_config(const fs::path& d, int dlk0, int dlk1) {
-  config::Config c = small_config(dlk0);
+  config::Config c = stop_rule_config(dlk0, 1e-8, 0.2);
   c.rod_perturbation = {0.0};
   c.electrostatics_enabled = false;
   c.time_t_end_us = 0.5;
-  c.time_stop_kinetic_kT = 1e-8;
-  c.time_stability_probe_us = 0.2;
-  c.output_every_steps = 100;
-  c.output_frame_every_steps = 0;
-  c.output_checkpoint_every_steps = 0;
-  c.run_threads = 1;
   config::apply_override(c, "rods.0.offset_A=[0, 0, -25]");
   config::apply_override(c, "rods.1.offset_A=[0, 0, 25]");
   config::apply_override(c, "rods.1.excess_link=" + std::to_string(dlk1));
-  const fs::path p = d / ("rings" + std::to_string(dlk0) + std::to_string(dlk1) + ".toml");
-  std::ofstream(p) << small_config_toml(c);
-  return p;
+  return write_config(d, c, "rings" + std::to_string(dlk0) + std::to_string(dlk1) + ".toml");
 }
 
 }  // namespace
@@ -163,20 +161,14 @@ TEST(StabilityTest, SeveralRodsAreEachKickedAndTheUnstableOneBuckles) {
 // approach 19.1 Å, E_steric 1.37 kT, the kick +1.08 kT above the continuation at the end.
 TEST(StabilityTest, AnImplicitRunComesToRestInAContactStateAsAVerifiedEquilibrium) {
   const fs::path d = fresh_dir("stability_implicit_contact");
-  config::Config c = small_config(4);
+  config::Config c = stop_rule_config(4, 1e-7, 0.5);
   c.time_scheme = "implicit";
   c.time_implicit_order = 2;
   c.time_implicit_local_mobility = "overlap";
   c.time_dt_ns = 4.4;
   c.time_t_end_us = 10;
-  c.time_stop_kinetic_kT = 1e-7;
-  c.time_stability_probe_us = 0.5;
   c.output_every_us = 0.1;
-  c.output_frame_every_steps = 0;
-  c.output_checkpoint_every_steps = 0;
-  c.run_threads = 1;
-  const fs::path cfg = d / "contact.toml";
-  std::ofstream(cfg) << small_config_toml(c);
+  const fs::path cfg = write_config(d, c, "contact.toml");
   const Exit e = run_ibrod({"run", cfg.string(), "-o", (d / "out").string()}, d / "out.log");
   ASSERT_EQ(e.code, 0) << e.output;
   const std::string summary = read_file(d / "out" / "summary.json");
