@@ -369,6 +369,7 @@ sim::SimParams to_params(const Config& c) {
       overlap ? c.time_implicit_overlap_scale : c.time_implicit_mobility_scale;
   p.implicit.jacobian_every =
       overlap ? c.time_implicit_overlap_refresh_every : c.time_implicit_jacobian_every;
+  p.implicit.refresh_displacement = c.time_implicit_refresh_displacement_A * angstrom;
   p.implicit.krylov_max_iter = c.time_implicit_krylov_iterations;
   p.implicit.krylov_tol = c.time_implicit_krylov_tol;
   // issue 24: the two-stage step and its error control (order 1 has no estimate: off)

@@ -245,6 +245,10 @@ void Run::State::finish(const sim::Observables& o, const std::string& stop_reaso
   r.final = o;
   r.wall_s = seconds_since(t0);
   r.ms_per_step = ms_per_step();
+  if (const integrate::ImplicitIntegrator* imp = sim->implicit()) {
+    r.implicit_factorizations = imp->stepper().timings().factorizations;
+    r.implicit_early_refreshes = imp->stepper().timings().moved_refreshes;
+  }
   r.link_drift = o.link - r.initial.link;
   r.max_link_drift = meta.max_link_drift;
   r.self_passage_warning = meta.self_passage_warning;

@@ -61,6 +61,10 @@ struct RunResult {
   double link_drift = 0;              ///< final Lk − initial Lk
   double max_link_drift = 0;          ///< max |Lk − Lk(0)| over the output steps
   bool self_passage_warning = false;  ///< max_link_drift > kLinkDriftWarning
+  /// implicit scheme, this process: factorisations of the local system, and refreshes of K made
+  /// early by time.implicit_refresh_displacement_A (−1: the explicit scheme)
+  long implicit_factorizations = -1;
+  long implicit_early_refreshes = -1;
 };
 
 /// |Lk − Lk(0)| beyond which a run warns (once) of a likely self-passage.

@@ -82,6 +82,11 @@ std::string summary_json(const config::Config& c, bool closed, const RunResult& 
                                : nlohmann::ordered_json(nullptr);
   j["wall_time_s"] = r.wall_s;
   j["ms_per_step"] = r.ms_per_step;
+  // the implicit scheme's factorisations of its local system in this process (docs/large_dt.md)
+  if (r.implicit_factorizations >= 0) {
+    j["implicit_factorizations"] = r.implicit_factorizations;
+    j["implicit_early_refreshes"] = r.implicit_early_refreshes;
+  }
   j["total_wall_time_s"] = meta.wall_s;
   j["threads"] = meta.threads;
   j["resumed_from_step"] = r.resumed_from >= 0 ? nlohmann::ordered_json(r.resumed_from)

@@ -174,7 +174,18 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
   pack(c0.F, c0.T, b);
 
   if (local || p_.krylov_max_iter > 0) {
+    bool moved = false;
+    if (p_.refresh_displacement > 0 && have_K_ && X_K_.size() == s.X.size()) {
+      const double d2 = p_.refresh_displacement * p_.refresh_displacement;
+      for (std::size_t k = 0; k < s.X.size() && !moved; ++k)
+        moved = (s.X[k] - X_K_[k]).squaredNorm() > d2;
+    }
+    if (moved) {
+      steps_since_jacobian_ = 0;
+      ++timings_.moved_refreshes;
+    }
     if (steps_since_jacobian_ == 0 || !have_K_) {
+      X_K_ = s.X;
       const double t0 = now();
       // the fast path: no contacts, the local system is block-diagonal over the rods, each
       // block block-cyclic-tridiagonal (closed) or block-tridiagonal (open)

@@ -46,6 +46,12 @@ struct ImplicitParams {
   /// reference (4: 5.3–5.5 against 7.0–7.1 ms, the same accuracy; docs/large_dt.md), and then
   /// only resumes from the periodic checkpoints are bitwise (Simulation::checkpoint_taken).
   int jacobian_every = 1;
+  /// K (and M_loc, and their factorisation) are also refreshed before jacobian_every steps when
+  /// a rod point has moved farther than this since the last refresh, Å (0: off). W's error is its
+  /// age measured in the geometry it was made for (docs/large_dt.md §6, §8): through a collapse
+  /// the points move fast and W is remade every few steps, near rest it is kept for
+  /// jacobian_every steps.
+  double refresh_displacement = 0;
   bool velocity_form = true;  ///< (I + Δt M_loc K) u = M F (true) or (I + Δt K M_loc) g = F
   /// the length that turns a rotation error (rad) into a displacement of the rod's surface in the
   /// error estimate, Å (the steric radius D/2)
@@ -102,6 +108,7 @@ struct ImplicitTimings {
   double overlap = 0;       ///< building M_loc = β D O D (in stiffness too)
   double analyze = 0;       ///< the LU's pattern analysis (in factorize too)
   long factorizations = 0;  ///< of the local system (count)
+  long moved_refreshes = 0;  ///< refreshes of K made early by refresh_displacement (count)
 };
 
 class ImplicitStepper {
@@ -183,6 +190,7 @@ class ImplicitStepper {
   int contacts_ = 0, pattern_contacts_ = 0;  // steric contacts in K, in the analysed pattern
   double lu_dt_ = -1;                        // dt of the current factorisation (−1: none)
   long steps_since_jacobian_ = 0;
+  std::vector<Vec3> X_K_;  // the positions where K (and M_loc) were last made
   StepEnergies last_;
   ImplicitTimings timings_;
   rod::RodWork work_;                            // one rod's (finite-difference K)
@@ -235,6 +243,7 @@ class ImplicitIntegrator final : public Scheme {
   void restore(const State& st);
   void refresh() override { stepper_.refresh_jacobian(); }
   ImplicitStepper& stepper() { return stepper_; }
+  const ImplicitStepper& stepper() const { return stepper_; }
   const AdaptiveDt& controller() const { return ctl_; }
 
  private:

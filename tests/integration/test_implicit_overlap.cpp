@@ -85,5 +85,75 @@ TEST(ImplicitOverlap, StiffModesDecayAtStepsFarBeyondTheExplicitLimit) {
     }
 }
 
+TEST(ImplicitOverlap, ARefreshDisplacementRemakesWWhereverThePointsHaveMovedThatFar) {
+  // time.implicit_refresh_displacement_A (docs/large_dt.md §8): W = I + γΔt M_loc K is remade
+  // before its count of steps once a rod point has moved farther than δ since it was made. The
+  // relaxing untwisted ring (perturbation 3) at 2 ns, ROS2, W kept for up to 1000 steps:
+  //  - δ below any step's motion: W at every step, bitwise the run that refreshes every step;
+  //  - δ above the whole motion: one W, bitwise the run without the rule;
+  //  - δ in between: W remade only once a point has moved farther than δ, never used at a
+  //    state farther than δ from the one it was made at, and the path closer to the every-step
+  //    one than the single W's.
+  const double dt = 2e-9;
+  const int steps = 25;
+  auto run = [&](int every, double delta, std::vector<double>* max_age) {
+    Ring r(LocalMobility::overlap, 1.0, 2, 0, {3.0}, every);
+    integrate::ImplicitParams ip;
+    ip.local_mobility = LocalMobility::overlap;
+    ip.mobility_scale = 1.0;
+    ip.order = 2;
+    ip.jacobian_every = every;
+    ip.refresh_displacement = delta;
+    r.imp = std::make_unique<integrate::ImplicitStepper>(*r.st, ip);
+    std::vector<Vec3> made = r.rod.X;  // where the latest W was made
+    for (int k = 0; k < steps; ++k) {
+      const std::vector<Vec3> xn = r.rod.X;
+      double age = 0;  // how far the points are from where W was made
+      for (std::size_t i = 0; i < xn.size(); ++i) age = std::max(age, (xn[i] - made[i]).norm());
+      const auto info = r.imp->step(r.rod, dt);
+      EXPECT_TRUE(info.finite);
+      if (info.jacobian_refreshed) {
+        if (max_age && k > 0) max_age->push_back(age);
+        made = xn;
+      } else if (delta > 0) {
+        EXPECT_LE(age, delta) << "step " << k << ": W used " << age << " Å from where it was made";
+      }
+    }
+    return r;
+  };
+  Ring every = run(1, 0.0, nullptr);
+  Ring tiny = run(1000, 1e-9, nullptr);
+  Ring once = run(1000, 0.0, nullptr);
+  Ring huge = run(1000, 1e4, nullptr);
+  EXPECT_EQ(every.imp->timings().factorizations, steps);
+  EXPECT_EQ(tiny.imp->timings().factorizations, steps);
+  EXPECT_EQ(tiny.imp->timings().moved_refreshes, steps - 1);
+  EXPECT_EQ(once.imp->timings().factorizations, 1);
+  EXPECT_EQ(huge.imp->timings().factorizations, 1);
+  EXPECT_EQ(huge.imp->timings().moved_refreshes, 0);
+  for (std::size_t i = 0; i < every.rod.X.size(); ++i) {
+    ASSERT_EQ(tiny.rod.X[i], every.rod.X[i]) << i;
+    ASSERT_EQ(huge.rod.X[i], once.rod.X[i]) << i;
+  }
+  const double delta = 0.5;  // Å
+  std::vector<double> ages;
+  Ring mid = run(1000, delta, &ages);
+  const long lu = mid.imp->timings().factorizations;
+  EXPECT_GT(lu, 2);
+  EXPECT_LT(lu, steps);
+  std::printf("delta %.2f A: %ld LUs in %d steps; ages at refresh:", delta, lu, steps);
+  for (double a : ages) std::printf(" %.3f", a);
+  std::printf("\n");
+  for (std::size_t j = 0; j < ages.size(); ++j) EXPECT_GT(ages[j], delta) << j;  // not early
+  auto dist = [&](const Ring& a) {
+    double d = 0;
+    for (std::size_t i = 0; i < a.rod.X.size(); ++i)
+      d = std::max(d, (a.rod.X[i] - every.rod.X[i]).norm());
+    return d;
+  };
+  std::printf("distance to every-step W: delta %.4f, single W %.4f A\n", dist(mid), dist(once));
+  EXPECT_LT(dist(mid), dist(once));
+}
+
 }  // namespace
 }  // namespace ibrod

@@ -68,9 +68,20 @@ TEST(SchemeKeys, TheOverlapLocalMobilityAndItsScaleReachTheParameters) {
   EXPECT_EQ(p.implicit.jacobian_every, 10);          // the overlap's refresh
   config::apply_override(c, "time.implicit_overlap_refresh_every=3");
   EXPECT_EQ(config::to_params(c).implicit.jacobian_every, 3);
+  EXPECT_DOUBLE_EQ(config::to_params(c).implicit.refresh_displacement, 0);  // off by default
+  config::apply_override(c, "time.implicit_refresh_displacement_A=1.5");
+  EXPECT_DOUBLE_EQ(config::to_params(c).implicit.refresh_displacement, 1.5);  // Å
+  try {
+    config::apply_override(c, "time.implicit_refresh_displacement_A=-1");
+    FAIL() << "accepted a negative refresh displacement";
+  } catch (const ConfigError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("time.implicit_refresh_displacement_A"));
+    EXPECT_THAT(e.what(), HasSubstr("-1"));
+  }
   EXPECT_THAT(config::to_toml(c), HasSubstr("implicit_local_mobility = 'overlap'"));
   for (const char* k : {"time.implicit_local_mobility", "time.implicit_overlap_scale",
-                        "time.implicit_overlap_refresh_every"})
+                        "time.implicit_overlap_refresh_every",
+                        "time.implicit_refresh_displacement_A"})
     EXPECT_THAT(config::describe(c), HasSubstr(k));
   try {
     config::apply_override(c, "time.implicit_local_mobility=\"banded\"");
