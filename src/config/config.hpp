@@ -49,8 +49,8 @@ struct Config {
   /// issue 24)
   std::string time_implicit_local_mobility = "self";
   double time_implicit_overlap_scale = 1;        ///< implicit: β of the overlap M_loc
-  int time_implicit_overlap_refresh_every = 10;  ///< implicit, overlap: steps between its LUs
-  double time_implicit_refresh_displacement_A = 0;  ///< implicit: refresh W when a point moved this far, Å (0: off)
+  int time_implicit_overlap_refresh_every = 50;  ///< implicit, overlap: steps between its LUs
+  double time_implicit_refresh_displacement_A = 1;  ///< implicit: refresh W when a point moved this far, Å (0: off)
   int time_implicit_jacobian_every = 1;          ///< implicit: steps between stiffness refreshes
   int time_implicit_krylov_iterations = 0;       ///< implicit: GMRES iterations (0: IMEX)
   double time_implicit_krylov_tol = 1e-2;        ///< implicit: GMRES relative residual

@@ -65,10 +65,10 @@ TEST(SchemeKeys, TheOverlapLocalMobilityAndItsScaleReachTheParameters) {
   const sim::SimParams p = config::to_params(c);
   EXPECT_EQ(p.implicit.local_mobility, integrate::ImplicitParams::LocalMobility::overlap);
   EXPECT_DOUBLE_EQ(p.implicit.mobility_scale, 0.5);  // the overlap's scale, not the self one's
-  EXPECT_EQ(p.implicit.jacobian_every, 10);          // the overlap's refresh
+  EXPECT_EQ(p.implicit.jacobian_every, 50);          // the overlap's refresh
   config::apply_override(c, "time.implicit_overlap_refresh_every=3");
   EXPECT_EQ(config::to_params(c).implicit.jacobian_every, 3);
-  EXPECT_DOUBLE_EQ(config::to_params(c).implicit.refresh_displacement, 0);  // off by default
+  EXPECT_DOUBLE_EQ(config::to_params(c).implicit.refresh_displacement, 1);  // Å, by default
   config::apply_override(c, "time.implicit_refresh_displacement_A=1.5");
   EXPECT_DOUBLE_EQ(config::to_params(c).implicit.refresh_displacement, 1.5);  // Å
   try {
