@@ -119,9 +119,9 @@ int main(int argc, char** argv) {
   write(out + "/K_stretch.bin", k_with(Vec3::Zero(), rp0.b));
   write(out + "/K_bend.bin", k_with(Vec3(rp0.a.x(), rp0.a.y(), 0), Vec3::Zero()));
   write(out + "/K_twist.bin", k_with(Vec3(0, 0, rp0.a.z()), Vec3::Zero()));
-  std::ofstream(out + "/info.txt") << n << " " << p.stepper.rods[0].ds << " " << p.kT << " "
-                                   << imp.self_mobility_translation() << " "
-                                   << imp.self_mobility_rotation() << "\n";
+  std::ofstream(out + "/info.txt")
+      << n << " " << p.stepper.rods[0].ds << " " << p.kT << " " << imp.self_mobility_translation()
+      << " " << imp.self_mobility_rotation() << "\n";
   if (onestep < 0) {
     // the deterministic step's linear map on −onestep random δ (1e-5 Å, 1e-6 rad): columns
     // (δ, step(q0 + δ) − step(q0)) in linstep.bin, against linear_ring.py's B
