@@ -481,9 +481,11 @@ const std::vector<Key>& schema() {
                "temperature for kT, K"),
       boolean("solvent.advection", &Config::solvent_advection,
               "include the nonlinear advection term ρ u·∇u"),
-      boolean("solvent.thermal", &Config::solvent_thermal,
-              "thermal fluctuations at solvent.temperature_K: a random stress in the fluid, keyed "
-              "by run.seed (explicit scheme; docs/thermal.md)"),
+      boolean(
+          "solvent.thermal", &Config::solvent_thermal,
+          "thermal fluctuations at solvent.temperature_K: a random stress in the fluid, keyed "
+          "by run.seed (both schemes; implicit: with the overlap M_loc at order 1, a fixed Δt = "
+          "time.dt_ns; docs/thermal.md)"),
       boolean("solvent.thermal_drift", &Config::solvent_thermal_drift,
               "with solvent.thermal: add the stochastic drift kT ∂·M by a random finite "
               "difference of the spreading and a midpoint interpolation (docs/thermal.md)"),

@@ -542,6 +542,12 @@ void FluidSolver::solve_slice_stokes(int j) {
   }
 }
 
+void FluidSolver::set_dt(double dt) {
+  if (!(dt > 0.0) || !std::isfinite(dt))
+    throw std::invalid_argument("FluidSolver::set_dt: dt must be positive and finite");
+  params_.dt = dt;
+}
+
 void FluidSolver::solve_stokes(const PlaneForcing& forcing, const PlaneSampler* sampler,
                                bool thermal) {
   if (!(params_.viscosity > 0.0))

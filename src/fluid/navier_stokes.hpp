@@ -103,6 +103,10 @@ class FluidSolver {
   /// every step (Navier–Stokes, not solve_stokes). A caller that restores a state sets it (the
   /// simulation: the step number), so that a resumed run draws the same numbers.
   void set_noise_step(std::uint64_t s) { noise_step_ = s; }
+  /// Δt of the following steps and thermal Stokes solves, s (> 0; read at each solve, nothing
+  /// cached: the implicit scheme sets it before each thermal solve, whose noise variance is
+  /// ∝ 1/Δt). Throws std::invalid_argument otherwise.
+  void set_dt(double dt);
   std::uint64_t noise_step() const { return noise_step_; }
 
   /// Advance u by one step Δt with the current force density (MODEL §4). No allocation.

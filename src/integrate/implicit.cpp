@@ -1,6 +1,7 @@
 #include "integrate/implicit.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -9,6 +10,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "core/philox.hpp"
 #include "integrate/local_mobility.hpp"
 
 namespace ibrod::integrate {
@@ -47,6 +49,16 @@ ImplicitStepper::ImplicitStepper(System& system, const ImplicitParams& p)
   if (p_.order == 2 && (p_.krylov_max_iter > 0 || !p_.velocity_form || !(p_.mobility_scale > 0)))
     throw std::invalid_argument(
         "ImplicitStepper: order 2 needs the velocity form, mobility_scale > 0 and no GMRES");
+  kT_ = st_.params().fluid.thermal_kT;
+  drift_ = kT_ > 0 && st_.params().thermal_drift;
+  if (kT_ > 0 &&
+      (p_.order != 1 || !p_.velocity_form || p_.krylov_max_iter > 0 ||
+       p_.local_mobility != ImplicitParams::LocalMobility::overlap || !(p_.mobility_scale > 0)))
+    throw std::invalid_argument(
+        "ImplicitStepper: thermal noise needs order 1, the velocity form, no GMRES and the "
+        "overlap local mobility with mobility_scale > 0 (docs/thermal.md)");
+  if (kT_ > 0 && !(p_.thermal_force_local >= 0 && p_.thermal_force_local <= 1))
+    throw std::invalid_argument("ImplicitStepper: thermal_force_local not in [0, 1]");
   for (auto* v : {&U_, &W_}) v->assign(n_, Vec3::Zero());
   bcc_.resize(rods_.size());
 
@@ -308,6 +320,78 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
         info.error = std::max({info.error, ex, p_.rotation_length * er});
       }
     }
+  } else if (kT_ > 0) {
+    // with thermal noise (docs/thermal.md, "The implicit step with noise"; a = 0: candidate D)
+    //   u = A [J G 𝒮(F + (1 − a) f_K) + J G ξ + a M_loc f_K],  A = (I + Δt M_loc K)⁻¹,
+    // G = (−μL_h)⁻¹P, ξ the random stress of the same solve, f_K ~ N(0, kT K_GN): the
+    // displacement's covariance Δt² A (2kT M/Δt + kT M K M) Aᵀ for a = 0
+    const std::uint64_t step = st_.fluid().noise_step();
+    const VectorXd fK =
+        p_.thermal_force ? thermal_force(s, step) : VectorXd(VectorXd::Zero(6 * Eigen::Index(n)));
+    const double a = p_.thermal_force_local;
+    const std::size_t pts = drift_ ? 3 * std::size_t(n) : std::size_t(n);
+    Xn_.resize(pts);
+    Fn_.resize(pts);
+    Tn_.assign(pts, Vec3::Zero());
+    for (int k = 0; k < n; ++k) {
+      Xn_[k] = s.X[k];
+      Fn_[k] = c0.F[k] + (1 - a) * fK.segment<3>(6 * k);
+      Tn_[k] = c0.T[k] + (1 - a) * fK.segment<3>(6 * k + 3);
+    }
+    if (drift_) {
+      // the random finite difference of the spreading (as Stepper::drift_step: the force pairs
+      // ±(kT/δ) W̃_k at X_k ± (δ/2) W̃_k, W̃ keyed by (seed; k, 1, step)): in the mean the force
+      // density kT ∂_X·𝒮, whose Stokes response J G kT ∂_X·𝒮 the rod picks up with M F
+      const double delta = 1e-4 * st_.params().grid.h();
+      const std::uint64_t seed = st_.params().fluid.seed;
+      const std::uint32_t key0 = std::uint32_t(seed), key1 = std::uint32_t(seed >> 32);
+      const std::uint32_t st0 = std::uint32_t(step), st1 = std::uint32_t(step >> 32);
+      for (int k = 0; k < n; ++k) {
+        double z[6];
+        unit_variance6(philox4x32_10({std::uint32_t(k), 1u, st0, st1}, key0, key1), z);
+        const Vec3 w(z[0], z[1], z[2]);
+        Xn_[n + k] = s.X[k] + (0.5 * delta) * w;
+        Xn_[2 * n + k] = s.X[k] - (0.5 * delta) * w;
+        Fn_[n + k] = (kT_ / delta) * w;
+        Fn_[2 * n + k] = -(kT_ / delta) * w;
+      }
+    }
+    ib::PlaneCoupler& pc = st_.plane_coupler();
+    fluid::FluidSolver& fl = st_.fluid();
+    fl.set_dt(dt);  // the random stress's variance is 2kT/Δt
+    const double t0 = now();
+    pc.prepare(Xn_, Fn_, Tn_);
+    {
+      const PlaneCouplerSampler sampler(pc, std::size_t(n));  // the force pairs: spread only
+      fl.solve_stokes(PlaneCouplerForcing(pc), &sampler, true);
+    }
+    pc.finish_interpolation(U_, W_, std::size_t(n));
+    timings_.stokes += now() - t0;
+    ++info.fluid_solves;
+    VectorXd v;
+    pack(U_, W_, v);
+    const VectorXd loc =
+        a > 0 ? VectorXd(a * (Mov_ * fK)) : VectorXd(VectorXd::Zero(6 * Eigen::Index(n)));
+    u = precondition(VectorXd(v + loc));
+    if (drift_) {
+      // (∂_X J) : G 𝒮 by the midpoint interpolation U, W = J(X̃) u, X̃ = Xⁿ + (Δt/2) u_X: the
+      // velocity the solve left on the grid, sampled plane by plane as Stepper::drift_step does
+      // (its mean over the noise is kT (∂_X J) : (A J G) — the Stokes-limit velocity covariance
+      // 2kT G/Δt on every mode — filtered like M F)
+      for (int k = 0; k < n; ++k) Xn_[k] = s.X[k] + (0.5 * dt) * u.segment<3>(6 * k);
+      const double t1 = now();
+      pc.prepare(std::span<const Vec3>(Xn_.data(), std::size_t(n)), {}, {});
+      const int N = st_.params().grid.n;
+      const std::size_t np = std::size_t(N) * std::size_t(N);
+      const std::array<const double*, 3> ug{fl.velocity(0), fl.velocity(1), fl.velocity(2)};
+#pragma omp parallel for schedule(static)
+      for (int i = 0; i < N; ++i)
+        pc.sample_plane(i, {ug[0] + i * np, ug[1] + i * np, ug[2] + i * np});
+      pc.finish_interpolation(U_, W_);
+      timings_.stokes += now() - t1;
+      pack(U_, W_, v);
+      u = precondition(VectorXd(v + loc));
+    }
   } else if (p_.velocity_form) {
     // (I + Δt M K) u = M F, δ = Δt u; the IMEX guess u₀ = (I + Δt M_loc K)⁻¹ M F
     const VectorXd mf = apply_mobility(b);
@@ -387,6 +471,16 @@ ImplicitIntegrator::ImplicitIntegrator(System& system, const ImplicitParams& p,
     : stepper_(system, p), ctl_(a) {}
 
 double ImplicitIntegrator::advance(rod::RodState& s, double max_dt) {
+  if (stepper_.thermal()) {
+    // with noise a step is never judged: a controller that rejects steps by their outcome
+    // would select the noise and bias the statistics. A fixed Δt = the controller's largest
+    // step (time.dt_ns), as the explicit scheme's (adaptive() is false: the cap is not taken,
+    // so a run cut at any step and resumed takes the same steps; docs/thermal.md)
+    const double dt = ctl_.params().dt_max;
+    info_ = stepper_.step(s, dt);
+    rejected_ = 0;
+    return dt;
+  }
   double dt = 0;
   info_ = step_adaptive(stepper_, s, ctl_, max_dt, &dt, &rejected_);
   return dt;

@@ -27,6 +27,7 @@
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseLU>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -81,6 +82,14 @@ struct ImplicitParams {
   /// out of M_loc, so that close strands of a supercoil do not fill the LU (0: no taper, the
   /// default: at 3 reaches the 64³ path runs ahead, docs/large_dt.md; one rod only)
   double overlap_window = 0.0;
+  /// thermal noise (the System's fluid.thermal_kT > 0; docs/thermal.md "The implicit step with
+  /// noise"): the share of the thermal force f_K ~ N(0, kT K) that goes through M_loc, the rest
+  /// through the Stokes mobility M in the same Stokes solve (0: candidate D, the default — on
+  /// the linearised 100 bp ring never above equipartition; 0.5: G; 1: C, both hot there)
+  double thermal_force_local = 0.0;
+  /// thermal noise: add the thermal force f_K at all (false: the random stress alone, candidate
+  /// A of docs/thermal.md)
+  bool thermal_force = true;
   double fd_dx = 1e-4;      ///< finite-difference step of K in positions, Å
   double fd_dtheta = 1e-5;  ///< ... and in rotation vectors, rad
 };
@@ -122,6 +131,17 @@ class ImplicitStepper {
   ImplicitStepper(System& system, const ImplicitParams& p);
   ~ImplicitStepper();
 
+  /// With thermal noise (the System's fluid.thermal_kT > 0; issue 28, docs/thermal.md "The
+  /// implicit step with noise"): order 1, velocity form, no GMRES, the overlap M_loc with
+  /// mobility_scale > 0 (else the constructor throws std::invalid_argument), and the step is
+  ///   u = (I + Δt M_loc K)⁻¹ [J(−μL_h)⁻¹P(𝒮(F + (1 − a) f_K) + ξ) + a M_loc f_K]
+  /// with ξ the random stress of the same Stokes solve (FluidSolver::solve_stokes, thermal),
+  /// f_K ~ N(0, kT K_GN) the thermal force of the Gauss–Newton stiffness (thermal_force) and
+  /// a = thermal_force_local; with the System's thermal_drift, the random finite difference of
+  /// the spreading joins the same solve and U, W are interpolated at the midpoint
+  /// X̃ = Xⁿ + (Δt/2) u_X (a second local solve). The draws are keyed by the fluid's seed and
+  /// noise_step() (set per step by the caller), so a step is a function of (qⁿ, Δt, seed,
+  /// step) alone.
   /// One implicit step of size dt (s): rod from qⁿ to qⁿ⁺¹. Returns what it did. The forces at
   /// qⁿ⁺¹ are computed here (for energy_after) and kept for the next step, so a step costs one
   /// force evaluation and 1 + krylov_iterations Stokes solves. The potential energies at qⁿ are
@@ -146,6 +166,13 @@ class ImplicitStepper {
   /// −∂(F, T)/∂(X, θ) (gauss_newton = false). Plus the stiffness of the steric contacts
   /// (positions only; see implicit.cpp).
   Eigen::SparseMatrix<double> stiffness(const rod::RodState& s);
+
+  /// The thermal force f_K = Σ_h J_hᵀ √(kT Δs C_h) η_h at s, [6n] per point (F, T): J_h the
+  /// small-strain strain Jacobian of half point h (as the Gauss–Newton K), C_h its moduli, η_h
+  /// six unit-variance numbers keyed by (fluid seed; counter: global half-point index, 2, step):
+  /// covariance kT K_GN (the steric contacts' stiffness not included). g Å s⁻², g Å² s⁻².
+  Eigen::VectorXd thermal_force(const rod::RodState& s, std::uint64_t step) const;
+  bool thermal() const { return kT_ > 0; }
 
   double self_mobility_translation() const { return m_t_; }  ///< Å s⁻¹ per g Å s⁻²
   double self_mobility_rotation() const { return m_r_; }     ///< s⁻¹ per g Å² s⁻²
@@ -196,6 +223,9 @@ class ImplicitStepper {
   rod::RodWork work_;                            // one rod's (finite-difference K)
   std::vector<Vec3> U_, W_, Fa_, Ta_, Fb_, Tb_;  // U_, W_: all points; the others one rod's
   rod::RodState pert_, stage_;
+  double kT_ = 0;                   // thermal noise: kT (0: none)
+  bool drift_ = false;              // thermal: the stochastic drift
+  std::vector<Vec3> Xn_, Fn_, Tn_;  // thermal: the points, forces and torques of the solve
   // forces at the state `cur_` (valid if has_cur_), and at the state before the latest step
   struct Cached {
     rod::RodState q;
@@ -234,7 +264,8 @@ class ImplicitIntegrator final : public Scheme {
   /// Scheme: one accepted step of at most max_dt (s; e.g. the time left to t_end): returns its
   /// Δt.
   double advance(rod::RodState& s, double max_dt) override;
-  bool adaptive() const override { return true; }
+  /// false with thermal noise: then a fixed Δt = the controller's dt_max, max_dt not taken
+  bool adaptive() const override { return !stepper_.thermal(); }
   const ImplicitStepInfo& last_info() const { return info_; }
   int last_rejections() const { return rejected_; }
   long rejections() const { return ctl_.rejections(); }

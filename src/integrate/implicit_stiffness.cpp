@@ -10,6 +10,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "core/philox.hpp"
 
 namespace ibrod::integrate {
 
@@ -44,6 +45,23 @@ Eigen::Matrix<double, 6, 1> moduli(const rod::RodParams& rp, int h) {
   Eigen::Matrix<double, 6, 1> c;
   c << b.x(), b.y(), b.z(), a.x(), a.y(), a.z();
   return c;
+}
+
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+
+// The small-strain strain Jacobian of the half point between points a and b (triad Dh,
+// X′ = xp): JL = ∂(Γ, Ω)/∂q_a, JR = ∂(Γ, Ω)/∂q_b (ImplicitStepper::gn_blocks below).
+void link_jacobians(const Mat3& Dh, const Vec3& xp, double ds, Mat6& JL, Mat6& JR) {
+  Mat3 G;  // rows (D^i × X′)ᵀ
+  for (int i = 0; i < 3; ++i) G.row(i) = Dh.col(i).cross(xp).transpose();
+  JL.setZero();
+  JR.setZero();
+  JL.block<3, 3>(0, 0) = -Dh.transpose() / ds;
+  JR.block<3, 3>(0, 0) = Dh.transpose() / ds;
+  JL.block<3, 3>(0, 3) = 0.5 * G;
+  JR.block<3, 3>(0, 3) = 0.5 * G;
+  JL.block<3, 3>(3, 3) = -Dh.transpose() / ds;
+  JR.block<3, 3>(3, 3) = Dh.transpose() / ds;
 }
 
 }  // namespace
@@ -150,7 +168,6 @@ void ImplicitStepper::gn_blocks(const rod::RodState& s) {
   // first): block-cyclic-tridiagonal per closed rod, block-tridiagonal per open one:
   // Kd_[k] = K[k][k], Ko_[k] = K[k+1][k].
   // tests/unit/integrate/test_implicit_parts.cpp compares it with the finite-difference K.
-  using Mat6 = Eigen::Matrix<double, 6, 6>;
   Kd_.assign(n_, Mat6::Zero());
   Ko_.assign(n_, Mat6::Zero());
   for (std::size_t r = 0; r < rods_.size(); ++r) {
@@ -161,21 +178,40 @@ void ImplicitStepper::gn_blocks(const rod::RodState& s) {
       const Eigen::Matrix<double, 6, 1> c = moduli(rp, h);
       const Mat3 Dh = rod::half_point_triad(s.D[a], s.D[b]);
       const Vec3 xp = (s.X[b] - s.X[a]) / rp.ds;
-      Mat3 G;  // rows (D^i × X′)ᵀ
-      for (int i = 0; i < 3; ++i) G.row(i) = Dh.col(i).cross(xp).transpose();
-      Mat6 JL = Mat6::Zero(), JR = Mat6::Zero();  // ∂(Γ, Ω)/∂q_h, ∂(Γ, Ω)/∂q_{h+1}
-      JL.block<3, 3>(0, 0) = -Dh.transpose() / rp.ds;
-      JR.block<3, 3>(0, 0) = Dh.transpose() / rp.ds;
-      JL.block<3, 3>(0, 3) = 0.5 * G;
-      JR.block<3, 3>(0, 3) = 0.5 * G;
-      JL.block<3, 3>(3, 3) = -Dh.transpose() / rp.ds;
-      JR.block<3, 3>(3, 3) = Dh.transpose() / rp.ds;
+      Mat6 JL, JR;  // ∂(Γ, Ω)/∂q_h, ∂(Γ, Ω)/∂q_{h+1}
+      link_jacobians(Dh, xp, rp.ds, JL, JR);
       const Mat6 CL = rp.ds * c.asDiagonal() * JL, CR = rp.ds * c.asDiagonal() * JR;
       Kd_[a].noalias() += JL.transpose() * CL;
       Kd_[b].noalias() += JR.transpose() * CR;
       Ko_[a].noalias() = JR.transpose() * CL;  // K[h+1][h]
     }
   }
+}
+
+Eigen::VectorXd ImplicitStepper::thermal_force(const rod::RodState& s, std::uint64_t step) const {
+  // f_K = Σ_h J_hᵀ √(kT Δs C_h) η_h: covariance Σ_h J_hᵀ kT Δs C_h J_h = kT K_GN (gn_blocks)
+  VectorXd f = VectorXd::Zero(6 * Eigen::Index(n_));
+  const std::uint64_t seed = st_.params().fluid.seed;
+  const std::uint32_t key0 = std::uint32_t(seed), key1 = std::uint32_t(seed >> 32);
+  const std::uint32_t st0 = std::uint32_t(step), st1 = std::uint32_t(step >> 32);
+  for (std::size_t r = 0; r < rods_.size(); ++r) {
+    const rod::RodParams& rp = rods_[r];
+    const rod::RodRange& g = ranges_[r];
+    for (int h = 0; h < rod::half_points(g.n, g.closed); ++h) {
+      const int a = g.offset + h, b = g.offset + (h + 1) % g.n;
+      const Eigen::Matrix<double, 6, 1> c = moduli(rp, h);
+      Mat6 JL, JR;
+      link_jacobians(rod::half_point_triad(s.D[a], s.D[b]), (s.X[b] - s.X[a]) / rp.ds, rp.ds, JL,
+                     JR);
+      double z[6];  // counter word 1 = 2: apart from the stress (0) and the drift's pairs (1)
+      unit_variance6(philox4x32_10({std::uint32_t(a), 2u, st0, st1}, key0, key1), z);
+      Eigen::Matrix<double, 6, 1> y;
+      for (int i = 0; i < 6; ++i) y[i] = std::sqrt(kT_ * rp.ds * c[i]) * z[i];
+      f.segment<6>(6 * a) += JL.transpose() * y;
+      f.segment<6>(6 * b) += JR.transpose() * y;
+    }
+  }
+  return f;
 }
 
 Eigen::SparseMatrix<double> ImplicitStepper::stiffness(const rod::RodState& s) {

@@ -56,10 +56,8 @@ SimParams checked(SimParams p) {
         "checkpoints: or 0)");
   p.stepper.fluid.dt = p.dt;  // the fluid's Δt is the simulation's
   if (p.stepper.fluid.thermal_kT > 0) {
-    if (p.scheme == TimeScheme::implicit_step)
-      throw std::invalid_argument(
-          "Simulation: thermal noise (solvent.thermal) needs the explicit scheme "
-          "(time.scheme = \"explicit\")");
+    // (the implicit scheme takes noise with its overlap M_loc at order 1 only: ImplicitStepper
+    // throws otherwise, config::to_params refuses it first naming the keys)
     // docs/thermal.md: with noise the fluid never comes to rest, so the kinetic-energy
     // equilibrium rule (and the stability test it triggers) is off; a run ends at t_end
     p.stop_kinetic = 0;
