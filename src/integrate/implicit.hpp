@@ -70,10 +70,11 @@ struct ImplicitParams {
   /// solved by sparse LU)
   enum class LocalMobility { self, overlap };
   LocalMobility local_mobility = LocalMobility::self;
-  /// overlap: the taper along the rod, in reaches of the kernel along it (4c/Δs points; the
-  /// window is clamped to half the ring): pairs farther apart along the rod than this are left
-  /// out of M_loc, so that close strands of a supercoil do not fill the LU (0: no taper, the
-  /// default: at 3 reaches the 64³ path runs ahead, docs/large_dt.md; one rod only)
+  /// overlap: the taper along each rod, in reaches of the kernel along it (4c/Δs points; the
+  /// window is the narrowest rod's, clamped to half the shortest rod): pairs farther apart along
+  /// a rod than this, and pairs of two rods, are left out of M_loc, so that close strands of a
+  /// supercoil do not fill the LU (0: no taper, the default: at 3 reaches the 64³ path runs
+  /// ahead, docs/large_dt.md)
   double overlap_window = 0.0;
   double fd_dx = 1e-4;      ///< finite-difference step of K in positions, Å
   double fd_dtheta = 1e-5;  ///< ... and in rotation vectors, rad
