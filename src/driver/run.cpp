@@ -174,8 +174,7 @@ void Run::State::announce() {
     int excess_link = 0;  // the rods' together
     for (const sim::SimParams::Shape& shape : p.shapes) excess_link += shape.circle.excess_link;
     std::snprintf(
-        buf, sizeof buf,
-        "ibrod: %lld steps of %.4g ns on %d³, %s, ΔLk = %d, %d threads -> %s",
+        buf, sizeof buf, "ibrod: %lld steps of %.4g ns on %d³, %s, ΔLk = %d, %d threads -> %s",
         static_cast<long long>(sim->end_step()), sim->dt() / 1e-9, p.stepper.grid.n,
         rod::describe(sim->rod_ranges()).c_str(), excess_link, meta.threads, dir.root().c_str());
   }

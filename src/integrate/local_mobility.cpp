@@ -24,8 +24,7 @@ Eigen::SparseMatrix<double> kernel_overlap(std::span<const Vec3> X, const GridSp
 }
 
 Eigen::SparseMatrix<double> kernel_overlap(std::span<const Vec3> X, const GridSpec& grid, int m,
-                                           double window,
-                                           const std::vector<rod::RodRange>& rods) {
+                                           double window, const std::vector<rod::RodRange>& rods) {
   // 2 (4m + 2) ≤ n: two stencils overlap one way round the periodic box at most
   if (m < 1 || m > ib::kMaxKernelWidth || 2 * (4 * m + 2) > grid.n)
     throw std::invalid_argument("kernel_overlap: kernel width " + std::to_string(m) +

@@ -129,19 +129,19 @@ std::vector<RodColumn> rod_columns(std::span<const rod::RodRange> rods) {
   rod::for_each_rod(rods, [&](std::size_t r, const rod::RodRange&) {
     const std::string k = std::to_string(r);
     using PerRod = sim::Observables::PerRod;
-    for (auto [name, member] : {std::pair{"writhe_", &PerRod::writhe},
-                                std::pair{"twist_", &PerRod::twist},
-                                std::pair{"link_", &PerRod::link}})
+    for (auto [name, member] :
+         {std::pair{"writhe_", &PerRod::writhe}, std::pair{"twist_", &PerRod::twist},
+          std::pair{"link_", &PerRod::link}})
       c.push_back({name + k, [r, member](const sim::Observables& o) { return o.rod(r).*member; }});
   });
   std::size_t q = 0;  // the pair's place in Observables::pair_links
   rod::for_each_pair(rods, [&](std::size_t a, std::size_t b) {
     if (!rods[a].closed || !rods[b].closed) return;
-    c.push_back({"link_" + std::to_string(a) + "_" + std::to_string(b),
-                 [q](const sim::Observables& o) {
-                   return q < o.pair_links.size() ? o.pair_links[q]
-                                                  : std::numeric_limits<double>::quiet_NaN();
-                 }});
+    c.push_back(
+        {"link_" + std::to_string(a) + "_" + std::to_string(b), [q](const sim::Observables& o) {
+           return q < o.pair_links.size() ? o.pair_links[q]
+                                          : std::numeric_limits<double>::quiet_NaN();
+         }});
     ++q;
   });
   return c;

@@ -107,8 +107,8 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
 }
 
 Image render_rods(std::span<const Vec3> X, std::span<const Vec3> d1,
-                  std::span<const rod::RodRange> rods, double diameter, const View& view,
-                  int width, int height, const Style& style, std::span<const Vec3> frame) {
+                  std::span<const rod::RodRange> rods, double diameter, const View& view, int width,
+                  int height, const Style& style, std::span<const Vec3> frame) {
   const std::size_t n = X.size();
   if (n < 2) throw std::invalid_argument("render_rod: needs at least 2 points");
   if (d1.size() != n)

@@ -96,8 +96,7 @@ namespace {
 std::string count_problem(std::span<const rod::RodParams> rods, const rod::RodState& s) {
   const int n = rod::total_points(rods);
   if (s.size() == n && int(s.D.size()) == n) return {};
-  return std::to_string(s.size()) + " positions and " + std::to_string(s.D.size()) +
-         " triads; " +
+  return std::to_string(s.size()) + " positions and " + std::to_string(s.D.size()) + " triads; " +
          (rod::names_rods(rods) ? "the rods have " + std::to_string(n) + " points together"
                                 : "the rod has " + std::to_string(n) + " points (rod.base_pairs)");
 }
@@ -112,8 +111,8 @@ std::string rods_problem(std::span<const rod::RodParams> rods, const rod::RodSta
   rod::for_each_range(rods, [&](std::size_t r, const rod::RodRange& g) {
     const std::size_t at = std::size_t(g.offset), m = std::size_t(g.n);
     if (!bad.empty()) return;
-    if (std::string b = rod_problem(X.subspan(at, m), D.subspan(at, m), g.ds, tolerances[r],
-                                    g.closed);
+    if (std::string b =
+            rod_problem(X.subspan(at, m), D.subspan(at, m), g.ds, tolerances[r], g.closed);
         !b.empty())
       bad = rod::message_prefix(rods, r) + b;
   });

@@ -258,8 +258,8 @@ Observables Simulation::observe() {
     o.twist += t.twist;
     o.link += t.link;
     if (std::isfinite(t.closest)) closest = std::min(closest, t.closest);
-    o.bp_spacing_A = links == 0 ? t.spacing
-                                : (o.bp_spacing_A * links + t.spacing * t.links) / (links + t.links);
+    o.bp_spacing_A =
+        links == 0 ? t.spacing : (o.bp_spacing_A * links + t.spacing * t.links) / (links + t.links);
     links += t.links;
   }
   rod::for_each_pair(ranges, [&](std::size_t a, std::size_t b) {
@@ -268,9 +268,9 @@ Observables Simulation::observe() {
       for (int j = 0; j < gb.n; ++j)
         closest = std::min(closest, (X[ga.offset + i] - X[gb.offset + j]).norm());
     if (ga.closed && gb.closed)
-      o.pair_links.push_back(diagnostics::linking_number(
-          X.subspan(std::size_t(ga.offset), std::size_t(ga.n)),
-          X.subspan(std::size_t(gb.offset), std::size_t(gb.n))));
+      o.pair_links.push_back(
+          diagnostics::linking_number(X.subspan(std::size_t(ga.offset), std::size_t(ga.n)),
+                                      X.subspan(std::size_t(gb.offset), std::size_t(gb.n))));
   });
   o.closest_approach_A = closest;
   return o;
