@@ -27,7 +27,9 @@
 #include "core/error.hpp"
 #include "core/units.hpp"
 #include "driver/run.hpp"
+#include "io/csv.hpp"
 #include "io/observables.hpp"
+#include "rod/rod_set.hpp"
 
 namespace py = pybind11;
 using namespace ibrod;
@@ -238,37 +240,14 @@ class PySimulation {
       for (py::ssize_t r = 0; r < R; ++r) col.mutable_data()[r] = rows[r].*(f.member);
       d[f.name] = col;
     }
-    // several rods: each rod's writhe, twist and link (rods.csv's columns)
-    const std::size_t nrods = s().rods().size();
-    for (std::size_t q = 0; nrods > 1 && q < nrods; ++q)
-      for (int which = 0; which < 3; ++which) {
+    // where the files name the rods: rods.csv's columns (each rod's writhe, twist and link, each
+    // pair of closed rods' linking number)
+    const std::vector<rod::RodRange>& ranges = s().rod_ranges();
+    if (rod::names_rods(ranges))
+      for (const io::RodColumn& c : io::rod_columns(ranges)) {
         py::array_t<double> col(R);
-        for (py::ssize_t r = 0; r < R; ++r) {
-          const auto& pr = rows[r].rods;
-          const double v = q < pr.size() ? (which == 0   ? pr[q].writhe
-                                            : which == 1 ? pr[q].twist
-                                                         : pr[q].link)
-                                         : std::nan("");
-          col.mutable_data()[r] = v;
-        }
-        d[(std::string(which == 0   ? "writhe_"
-                       : which == 1 ? "twist_"
-                                    : "link_") +
-           std::to_string(q))
-              .c_str()] = col;
-      }
-    // and each pair of closed rods' linking number (rods.csv's link_a_b)
-    const auto& rp = s().rods();
-    std::size_t q = 0;
-    for (std::size_t a = 0; nrods > 1 && a < nrods; ++a)
-      for (std::size_t b = a + 1; b < nrods; ++b) {
-        if (!rp[a].closed || !rp[b].closed) continue;
-        py::array_t<double> col(R);
-        for (py::ssize_t r = 0; r < R; ++r)
-          col.mutable_data()[r] =
-              q < rows[r].pair_links.size() ? rows[r].pair_links[q] : std::nan("");
-        d[("link_" + std::to_string(a) + "_" + std::to_string(b)).c_str()] = col;
-        ++q;
+        for (py::ssize_t r = 0; r < R; ++r) col.mutable_data()[r] = c.value(rows[r]);
+        d[c.name.c_str()] = col;
       }
     return d;
   }

@@ -59,21 +59,28 @@ RunInfo read_run_info(const fs::path& dir) {
   info.excess_link = tbl["rod"]["excess_link"].value<int>().value_or(info.excess_link);
   info.salt_M = tbl["solvent"]["salt_M"].value<double>().value_or(info.salt_M);
   info.closed = tbl["rod"]["closed"].value<bool>().value_or(info.closed);
+  const int n = tbl["rod"]["base_pairs"].value<int>().value_or(config::Config().rod_base_pairs);
+  const double ds = tbl["rod"]["rise_A"].value<double>().value_or(config::Config().rod_rise_A);
+  info.rods = {{0, n, info.closed, ds}};
   if (tbl.contains("rods")) {
-    // several rods: each table resolved on top of [rod], as the run did
+    // [[rods]]: each table resolved on top of [rod], as the run did
     config::Config c;
     config::apply_toml(c, read_text_file(p, "analyze"), p.string());
+    info.rods.clear();
     int offset = 0;
-    for (int r = 0; r < config::rod_count(c); ++r) {
-      const config::Config cr = config::rod_config(c, r);
-      info.rods.push_back({offset, cr.rod_base_pairs, cr.rod_closed, cr.rod_rise_A});
-      offset += cr.rod_base_pairs;
+    for (const config::RodConfig& rc : config::rod_configs(c)) {
+      info.rods.push_back({offset, rc.keys.rod_base_pairs, rc.keys.rod_closed, rc.keys.rod_rise_A});
+      offset += rc.keys.rod_base_pairs;
     }
-    if (info.rods.size() == 1) info.rods.clear();
   }
   if (!(info.diameter_A > 0))
     throw ConfigError("'" + p.string() + "': steric.diameter_A must be positive");
   return info;
+}
+
+std::vector<rod::RodRange> RunInfo::layout(int n) const {
+  if (rod::total_points(rods) == n) return rods;
+  return {{0, n, closed, rods.front().ds}};
 }
 
 // ---- analyze
@@ -255,12 +262,12 @@ json to_json(const Analysis& a, const AnalyzeOptions& opt) {
   j["limiting_energies_kT"] = a.equilibrium ? e : json(nullptr);
   const ShapeAnalysis& sh = a.shapes;
   // the shape classes are of closed curves (docs/analysis.md): null for an open rod
-  j["shape"] = sh.final_shape && !a.open_rod && !a.several_rods
+  j["shape"] = sh.final_shape && !a.open_rod && a.one_ring
                    ? shape_json(sh.final_shape->shape, sh.final_shape->time_us)
                    : json(nullptr);
   // null without --frames, so that an earlier analysis's frames do not outlive a new one
   json fr = opt.every_frame ? json::array() : json(nullptr);
-  if (!a.open_rod && !a.several_rods)
+  if (!a.open_rod && a.one_ring)
     for (const auto& f : sh.frames) fr.push_back(shape_json(f.shape, f.time_us));
   j["shape_frames"] = fr;
   json contacts{{"distance_A", sh.contact_distance_A}};
@@ -306,7 +313,7 @@ Analysis analyze_run(const fs::path& dir, const AnalyzeOptions& opt) {
   const CsvTable table = read_csv_table(RunDir(dir).timeseries());
   Analysis a = analyze_timeseries(table, opt);
   const RunInfo info = read_run_info(dir);
-  a.several_rods = info.rods.size() > 1;
+  a.one_ring = rod::one_ring(info.rods);
   const double dc = opt.contact_distance_A > 0
                         ? opt.contact_distance_A
                         : default_contact_distance(info.diameter_A, info.salt_M);

@@ -30,9 +30,13 @@ struct RunInfo {
   int excess_link = 0;       ///< rod.excess_link
   double salt_M = 0;         ///< solvent.salt_M
   bool closed = true;        ///< rod.closed (an open rod: no closing segment, no Wr or ΔLk)
-  /// several rods ([[rods]]): each rod's layout (rod::RodRange), in the state's order; empty for
-  /// one rod
-  std::vector<rod::RodRange> rods;
+  /// each rod's layout (rod::RodRange), in the state's order: the [[rods]] tables resolved on
+  /// top of [rod], else the one rod of [rod] (rod.base_pairs, rod.closed, rod.rise_A; their
+  /// defaults without config.toml: layout() then fits the frames)
+  std::vector<rod::RodRange> rods{{0, 600, true, 3.4}};
+  /// The rods of a frame of n points: `rods`, or where they do not cover n points (no config.toml,
+  /// or one of another run) one rod of all n points, closed as `closed` says.
+  std::vector<rod::RodRange> layout(int n) const;
 };
 /// Reads DIR/config.toml; defaults (diameter 20 Å) for a missing file or key. A file that is not
 /// TOML throws ConfigError.
@@ -96,7 +100,8 @@ struct Analysis {
   bool stays_circular = false;  ///< |Wr| < AnalyzeOptions::circular_writhe throughout
   bool open_rod = false;        ///< no writhe in the time series (rod.closed = false): null for the
                                 ///< ring's measures (stays_circular, shape, the power law)
-  bool several_rods = false;    ///< [[rods]]: the shape classes (of one closed curve) are null
+  bool one_ring = true;  ///< the rods are one closed curve (rod::one_ring); else the shape classes
+                         ///< (of one closed curve) are null
   std::optional<double> kinetic_power_law_exponent;  ///< only for runs that stay circular
   std::optional<FitWindow> kinetic_power_law_fit;
 };

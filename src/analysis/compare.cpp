@@ -332,9 +332,10 @@ ComparedRun read_compared_run(const fs::path& dir, double contact_distance_A) {
   r.contact_distance_A = contact_distance_A > 0
                              ? contact_distance_A
                              : default_contact_distance(info.diameter_A, info.salt_M);
-  if (!info.closed || info.rods.size() > 1) {
-    r.shapes_note = info.closed ? "several rods: the shape classes are of one closed rod"
-                                : "an open rod: the shape classes are of closed rods";
+  if (!rod::one_ring(info.rods)) {
+    r.shapes_note = rod::names_rods(info.rods)
+                        ? "several rods: the shape classes are of one closed rod"
+                        : "an open rod: the shape classes are of closed rods";
     return r;
   }
   if (!fs::exists(rd.trajectory()))

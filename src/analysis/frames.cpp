@@ -304,8 +304,6 @@ std::vector<fs::path> render_run(const fs::path& dir, const RenderOptions& opt, 
     for (const auto& f : frames) all_points.insert(all_points.end(), f.X.begin(), f.X.end());
 
   render::Style style;
-  style.closed = info.closed;
-  style.rods = info.rods;
   if (opt.colour == "along")
     style.colouring = render::Colouring::along;
   else if (opt.colour == "height")
@@ -333,38 +331,34 @@ std::vector<fs::path> render_run(const fs::path& dir, const RenderOptions& opt, 
   for (std::size_t j = 0; j < jobs.size(); ++j) {
     const auto& [file, i] = jobs[j];
     const RodFrame& f = frames[i];
+    const std::vector<rod::RodRange> rods = info.layout(int(f.X.size()));
     if (labels) {
       char wr[192], lk[96];
-      if (!info.rods.empty()) {
-        // several rods: each closed rod's writhe (an open one's twist), in order
-        std::string w;
-        std::size_t off = 0;
-        for (const rod::RodRange& g : info.rods) {
-          const std::size_t m = std::size_t(g.n);
-          const bool closed = g.closed;
-          const std::span<const Vec3> x = std::span<const Vec3>(f.X).subspan(off, std::size_t(m));
-          const std::span<const Vec3> d = std::span<const Vec3>(f.d1).subspan(off, std::size_t(m));
-          char one[40];
-          std::snprintf(one, sizeof one, "%s%s = %.3f", w.empty() ? "" : "  ", closed ? "Wr" : "Tw",
-                        closed ? diagnostics::writhe(x) : diagnostics::twist_open(x, d));
-          w += one;
-          off += std::size_t(m);
-        }
-        std::snprintf(wr, sizeof wr, "%s", w.substr(0, sizeof wr - 1).c_str());
-        std::snprintf(lk, sizeof lk, "%zu rods   Cs = %g M", info.rods.size(), info.salt_M);
-      } else if (info.closed) {
-        std::snprintf(wr, sizeof wr, "Wr = %.3f", diagnostics::writhe(f.X));
-        std::snprintf(lk, sizeof lk, "ΔLk = %d   Cs = %g M", info.excess_link, info.salt_M);
-      } else {  // an open rod: no writhe or link, its twist (docs/model.md "Open rods")
-        std::snprintf(wr, sizeof wr, "Tw = %.3f", diagnostics::twist_open(f.X, f.d1));
-        std::snprintf(lk, sizeof lk, "Cs = %g M", info.salt_M);
+      // each closed rod's writhe (an open one's twist: docs/model.md "Open rods"), in order
+      std::string w;
+      for (const rod::RodRange& g : rods) {
+        const auto at = std::size_t(g.offset), m = std::size_t(g.n);
+        const std::span<const Vec3> x = std::span<const Vec3>(f.X).subspan(at, m);
+        const std::span<const Vec3> d = std::span<const Vec3>(f.d1).subspan(at, m);
+        char one[40];
+        std::snprintf(one, sizeof one, "%s%s = %.3f", w.empty() ? "" : "  ", g.closed ? "Wr" : "Tw",
+                      g.closed ? diagnostics::writhe(x) : diagnostics::twist_open(x, d));
+        w += one;
       }
+      std::snprintf(wr, sizeof wr, "%s", w.substr(0, sizeof wr - 1).c_str());
+      // the collection (rods named: their count), or the ring's excess link
+      if (rod::names_rods(rods))
+        std::snprintf(lk, sizeof lk, "%s   Cs = %g M", rod::count_label(rods).c_str(), info.salt_M);
+      else if (rod::one_ring(rods))
+        std::snprintf(lk, sizeof lk, "ΔLk = %d   Cs = %g M", info.excess_link, info.salt_M);
+      else
+        std::snprintf(lk, sizeof lk, "Cs = %g M", info.salt_M);
       style.labels = {"t = " + time_label(f.time_us) + " µs", wr, lk};
     }
     render::Image img;
     try {
-      img = render::render_rod(f.X, f.d1, info.diameter_A, job_view[j], opt.width, opt.height,
-                               style, all_points);
+      img = render::render_rods(f.X, f.d1, rods, info.diameter_A, job_view[j], opt.width,
+                                opt.height, style, all_points);
     } catch (const std::invalid_argument& e) {
       throw ConfigError(std::string("render: ") + e.what() + " (a larger --size, or --no-labels)");
     }

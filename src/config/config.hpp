@@ -127,8 +127,6 @@ struct Config {
 /// 0: no trajectory.
 std::int64_t frame_every(const Config& c);
 
-/// The number of rods: the [[rods]] tables, or 1 without any.
-int rod_count(const Config& c);
 /// Rod r's configuration: c with the keys of [[rods]] table r set on top of [rod] (and no
 /// [[rods]] of its own); c itself (rods cleared) for r = 0 without [[rods]]. Throws ConfigError
 /// naming the table for a key it does not accept.

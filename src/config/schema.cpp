@@ -630,8 +630,6 @@ void set_rod_tables(Config& c, const toml::node& node) {
 
 }  // namespace
 
-int rod_count(const Config& c) { return c.rods.empty() ? 1 : int(c.rods.size()); }
-
 Config rod_config(const Config& c, int r) {
   Config out = c;
   out.rods.clear();

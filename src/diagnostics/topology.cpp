@@ -219,4 +219,23 @@ double mean_spacing(std::span<const Vec3> X, bool closed) {
   return sum / edges;
 }
 
+RodTopology rod_topology(std::span<const Vec3> X, std::span<const Vec3> d1, bool closed,
+                         int min_separation) {
+  RodTopology t{};
+  if (closed) {
+    t.writhe = writhe(X);
+    t.twist = twist(X, d1);
+    t.link = t.writhe + t.twist;
+  } else {
+    // NaN is "not defined", written as an empty CSV field and null in JSON (io/observables)
+    t.writhe = t.link = std::numeric_limits<double>::quiet_NaN();
+    t.twist = twist_open(X, d1);
+  }
+  t.closest = closest_approach(X, min_separation, closed);
+  const int n = int(X.size());
+  t.links = closed ? n : (n > 0 ? n - 1 : 0);
+  t.spacing = mean_spacing(X, closed);
+  return t;
+}
+
 }  // namespace ibrod::diagnostics

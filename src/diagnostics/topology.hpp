@@ -47,6 +47,18 @@ double closest_approach(std::span<const Vec3> X, int min_separation, bool closed
 /// O(n).
 double mean_spacing(std::span<const Vec3> X, bool closed = true);
 
+/// One rod's row of the time series (MODEL §6): writhe, twist and link (link = Wr + Tw) of a
+/// closed rod; an open rod's twist (twist_open), its writhe and link NaN ("not defined": not
+/// topological with free ends; docs/model.md "Open rods"); the closest approach over pairs at
+/// least min_separation apart along the rod, the mean spacing and the count of links (n closed,
+/// n − 1 open). d1: each point's director D¹.
+struct RodTopology {
+  double writhe, twist, link, closest, spacing;  ///< spacing: the mean, Å
+  int links;
+};
+RodTopology rod_topology(std::span<const Vec3> X, std::span<const Vec3> d1, bool closed,
+                         int min_separation);
+
 // ---- additions (the pieces the functions above are built from; exposed for tests and debugging)
 
 /// The Gauss double integral ∫∫ (dr₁ × dr₂)·(r₁ − r₂)/|r₁ − r₂|³ over the straight segments

@@ -174,11 +174,9 @@ void Run::State::announce() {
     int excess_link = 0;  // the rods' together
     for (const sim::SimParams::Shape& shape : p.shapes) excess_link += shape.circle.excess_link;
     std::snprintf(
-        buf, sizeof buf,
-        "ibrod: %lld steps of %.4g ns on %d³, %d rod points (rods: %zu), ΔLk = %d, %d threads "
-        "-> %s",
+        buf, sizeof buf, "ibrod: %lld steps of %.4g ns on %d³, %s, ΔLk = %d, %d threads -> %s",
         static_cast<long long>(sim->end_step()), sim->dt() / 1e-9, p.stepper.grid.n,
-        sim->rod().size(), sim->rods().size(), excess_link, meta.threads, dir.root().c_str());
+        rod::describe(sim->rod_ranges()).c_str(), excess_link, meta.threads, dir.root().c_str());
   }
   say(buf);
   if (distributed)
@@ -335,28 +333,8 @@ StopReason Run::State::test_stability(StopReason candidate) {
 }
 
 void Run::State::check_link(const sim::Observables& o) {
-  double drift = 0;
-  const bool one = sim->rods().size() == 1;
-  if (one) {
-    // (one rod: against the initial row's link, which a checkpoint keeps; a checkpoint keeps no
-    // per-rod initial links)
-    if (!std::isfinite(o.link)) return;  // an open rod has no linking number to conserve
-    drift = std::abs(o.link - result.initial.link);
-  } else {
-    // several rods: each closed rod's own link (a passage between two rings changes neither)
-    bool any = false;
-    for (std::size_t r = 0; r < o.rods.size() && r < result.initial.rods.size(); ++r)
-      if (std::isfinite(o.rods[r].link)) {
-        any = true;
-        drift = std::max(drift, std::abs(o.rods[r].link - result.initial.rods[r].link));
-      }
-    // and each pair's linking number: one rod passing through another changes it
-    for (std::size_t q = 0; q < o.pair_links.size() && q < result.initial.pair_links.size(); ++q) {
-      any = true;
-      drift = std::max(drift, std::abs(o.pair_links[q] - result.initial.pair_links[q]));
-    }
-    if (!any) return;
-  }
+  const double drift = sim::link_drift(o, result.initial);
+  if (std::isnan(drift)) return;  // no linking number to conserve (open rods)
   meta.max_link_drift = std::max(meta.max_link_drift, drift);
   if (drift > kLinkDriftWarning && !meta.self_passage_warning) {
     meta.self_passage_warning = true;
@@ -368,9 +346,10 @@ void Run::State::check_link(const sim::Observables& o) {
                   "too small, or Δt too large); recorded in summary.json",
                   static_cast<long long>(o.step), o.link, o.link - result.initial.link,
                   result.initial.link, kLinkDriftWarning,
-                  one ? "the rod has probably passed through itself"
-                      : "a rod has probably passed through itself or another rod "
-                        "(rods.csv: each rod's link and each pair's)");
+                  rod::names_rods(sim->rod_ranges())
+                      ? "a rod has probably passed through itself or another rod "
+                        "(rods.csv: each rod's link and each pair's)"
+                      : "the rod has probably passed through itself");
     say(buf);
   }
 }

@@ -57,16 +57,17 @@ class RunFiles {
     const std::filesystem::path ts = dir.timeseries();
     const int n = sim.rod().size();
     for (const rod::RodParams& r : sim.rods()) rod_ds_.push_back(r.ds);
-    const bool several = sim.rods().size() > 1;
-    std::vector<bool> closed;
-    for (const rod::RodParams& r : sim.rods()) closed.push_back(r.closed);
-    const std::string rods_header = io::rods_header(closed);
+    // rods.csv and each point's rod (the H5MD species) where the files name the rods
+    const bool several = rod::names_rods(ranges_);
+    const std::string rods_header = io::rods_header(ranges_);
     if (resume_step < 0) {
       io::write_file_atomic(ts, io::timeseries_header() + "\n");
       if (several) io::write_file_atomic(dir.rods(), rods_header + "\n");
-      std::vector<int> species;  // several rods: each point's rod
-      for (std::size_t r = 0; several && r < ranges_.size(); ++r)
-        species.insert(species.end(), std::size_t(ranges_[r].n), int(r));
+      std::vector<int> species;
+      if (several)
+        rod::for_each_rod(ranges_, [&](std::size_t r, const rod::RodRange& g) {
+          species.insert(species.end(), std::size_t(g.n), int(r));
+        });
       if (frames_on_)
         h5_ = io::H5mdWriter::create(dir.trajectory(), n, c.grid_box_A, config_text, species);
     } else {

@@ -219,12 +219,17 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
       if (overlap && local) {
         // M_loc = β D O D at qⁿ
         const double t1 = now();
-        // the taper along the rod (off by default) for one rod only
-        const bool taper = p_.overlap_window > 0 && ranges_.size() == 1;
-        const double reach = 4 * st_.params().kernel_width * st_.params().grid.h() / rods_[0].ds;
-        const double window = taper ? std::min(p_.overlap_window * reach, 0.5 * n) : 0.0;
-        Mov_ = kernel_overlap(s.X, st_.params().grid, st_.params().kernel_width, window,
-                              ranges_[0].closed);
+        // the taper along each rod (off by default), in points: the narrowest of the rods'
+        // (each rod's kernel reach along it, clamped to half the rod)
+        double window = 0.0;
+        if (p_.overlap_window > 0) {
+          window = HUGE_VAL;
+          for (const rod::RodRange& g : ranges_) {
+            const double reach = 4 * st_.params().kernel_width * st_.params().grid.h() / g.ds;
+            window = std::min(window, std::min(p_.overlap_window * reach, 0.5 * g.n));
+          }
+        }
+        Mov_ = kernel_overlap(s.X, st_.params().grid, st_.params().kernel_width, window, ranges_);
         auto d = [&](Eigen::Index i) { return i % 6 < 3 ? ov_t_ : ov_r_; };
         for (Eigen::Index c = 0; c < Mov_.outerSize(); ++c)
           for (Eigen::SparseMatrix<double>::InnerIterator it(Mov_, c); it; ++it)

@@ -77,10 +77,11 @@ struct ImplicitParams {
   /// solved by sparse LU)
   enum class LocalMobility { self, overlap };
   LocalMobility local_mobility = LocalMobility::self;
-  /// overlap: the taper along the rod, in reaches of the kernel along it (4c/Δs points; the
-  /// window is clamped to half the ring): pairs farther apart along the rod than this are left
-  /// out of M_loc, so that close strands of a supercoil do not fill the LU (0: no taper, the
-  /// default: at 3 reaches the 64³ path runs ahead, docs/large_dt.md; one rod only)
+  /// overlap: the taper along each rod, in reaches of the kernel along it (4c/Δs points; the
+  /// window is the narrowest rod's, clamped to half the shortest rod): pairs farther apart along
+  /// a rod than this, and pairs of two rods, are left out of M_loc, so that close strands of a
+  /// supercoil do not fill the LU (0: no taper, the default: at 3 reaches the 64³ path runs
+  /// ahead, docs/large_dt.md)
   double overlap_window = 0.0;
   /// thermal noise (the System's fluid.thermal_kT > 0; docs/thermal.md "The implicit step with
   /// noise"): the share of the thermal force f_K ~ N(0, kT K) that goes through M_loc, the rest

@@ -398,8 +398,7 @@ void ImplicitStepper::factorize(double dt) {
     // block-diagonal over the rods: each rod's band factorised on its own
     std::vector<Eigen::Matrix<double, 6, 6>>& diag = sdiag_;
     std::vector<Eigen::Matrix<double, 6, 6>>& lower = slower_;
-    for (std::size_t r = 0; r < ranges_.size(); ++r) {
-      const rod::RodRange& g = ranges_[r];
+    rod::for_each_rod(ranges_, [&](std::size_t r, const rod::RodRange& g) {
       diag.resize(g.n);
       lower.resize(g.n);
       for (int j = 0; j < g.n; ++j) {
@@ -410,7 +409,7 @@ void ImplicitStepper::factorize(double dt) {
       }
       if (!bcc_[r].factorize(diag, lower, g.closed))
         throw std::runtime_error("ImplicitStepper: the local implicit system is not positive");
-    }
+    });
     lu_dt_ = dt;
     return;
   }
@@ -456,8 +455,9 @@ void ImplicitStepper::factorize(double dt) {
 Eigen::VectorXd ImplicitStepper::local_solve(const Eigen::VectorXd& v) const {
   if (use_blocks_) {
     VectorXd x = p_.velocity_form ? VectorXd(v.cwiseQuotient(mloc_)) : v;
-    for (std::size_t r = 0; r < ranges_.size(); ++r)
-      bcc_[r].solve(x.segment(6 * ranges_[r].offset, 6 * ranges_[r].n));
+    rod::for_each_rod(ranges_, [&](std::size_t r, const rod::RodRange& g) {
+      bcc_[r].solve(x.segment(6 * g.offset, 6 * g.n));
+    });
     return p_.velocity_form ? x : VectorXd(x.cwiseQuotient(mloc_));
   }
   if (!p_.gauss_newton || p_.local_mobility == ImplicitParams::LocalMobility::overlap)

@@ -20,22 +20,34 @@ Eigen::Matrix3d cross_matrix(const Vec3& a) {
 }  // namespace
 
 Eigen::SparseMatrix<double> kernel_overlap(std::span<const Vec3> X, const GridSpec& grid, int m) {
-  return kernel_overlap(X, grid, m, 0.0, false);
+  return kernel_overlap(X, grid, m, 0.0, {});
 }
 
 Eigen::SparseMatrix<double> kernel_overlap(std::span<const Vec3> X, const GridSpec& grid, int m,
-                                           double window, bool closed) {
+                                           double window, const std::vector<rod::RodRange>& rods) {
   // 2 (4m + 2) ≤ n: two stencils overlap one way round the periodic box at most
   if (m < 1 || m > ib::kMaxKernelWidth || 2 * (4 * m + 2) > grid.n)
     throw std::invalid_argument("kernel_overlap: kernel width " + std::to_string(m) +
                                 " not in 1 … " + std::to_string(ib::kMaxKernelWidth) +
                                 " or twice its stencil wider than the grid");
   ib::detail::check_positions(X, grid.h());
-  if (closed && window > 0 && X.size() < 2 * window)
-    throw std::invalid_argument("kernel_overlap: a closed chain of " + std::to_string(X.size()) +
-                                " points is shorter than twice the taper's window " +
-                                std::to_string(window));
   const int n = static_cast<int>(X.size());
+  // each point's rod and place along it (the taper's distances)
+  std::vector<int> rod_of(window > 0 ? n : 0), along(window > 0 ? n : 0);
+  if (window > 0) {
+    if (rod::total_points(rods) != n)
+      throw std::invalid_argument("kernel_overlap: the rods' points are not X's");
+    rod::for_each_rod(rods, [&](std::size_t r, const rod::RodRange& g) {
+      if (g.closed && g.n < 2 * window)
+        throw std::invalid_argument("kernel_overlap: a closed chain of " + std::to_string(g.n) +
+                                    " points is shorter than twice the taper's window " +
+                                    std::to_string(window));
+      for (int k = 0; k < g.n; ++k) {
+        rod_of[g.offset + k] = int(r);
+        along[g.offset + k] = k;
+      }
+    });
+  }
   const double h = grid.h();
   std::vector<ib::detail::PointStencil> st;
   st.reserve(n);
@@ -50,8 +62,10 @@ Eigen::SparseMatrix<double> kernel_overlap(std::span<const Vec3> X, const GridSp
   };
   auto taper_of = [&](int j, int k) {
     if (window <= 0) return 1.0;
-    const int a = std::abs(k - j);
-    const int d = closed ? std::min(a, n - a) : a;
+    if (rod_of[j] != rod_of[k]) return 0.0;  // two rods: dropped
+    const rod::RodRange& g = rods[std::size_t(rod_of[j])];
+    const int a = std::abs(along[k] - along[j]);
+    const int d = g.closed ? std::min(a, g.n - a) : a;
     return 1 - d / window;
   };
   // the points by the x index of their stencil (counting sort), so that each point meets only

@@ -23,9 +23,11 @@
 // Each sum factorises over the three dimensions into 1-D sums of φ and dφ.
 #include <Eigen/Sparse>
 #include <span>
+#include <vector>
 
 #include "core/grid.hpp"
 #include "core/types.hpp"
+#include "rod/rod_set.hpp"
 
 namespace ibrod::integrate {
 
@@ -36,14 +38,17 @@ namespace ibrod::integrate {
 /// Throws std::invalid_argument for m < 1, m > ib::kMaxKernelWidth or 2 (4m + 2) > grid.n.
 Eigen::SparseMatrix<double> kernel_overlap(std::span<const Vec3> X, const GridSpec& grid, int m);
 
-/// The overlap of points along one chain, tapered with the chain distance d = |j − k| (closed:
-/// min(|j − k|, n − |j − k|)): block (j, k) times max(0, 1 − d/window). The taper is a positive
-/// semi-definite matrix (its spectrum is a Fejér kernel; closed chains need n ≥ 2·window), so the
-/// Schur product stays positive semi-definite (Schur's product theorem). With a window wider than
-/// the kernel's reach along the chain (4c / spacing points) it keeps the chain's own overlap
-/// nearly whole and drops that of strands far apart along the chain but close in space, which
-/// would make the local system's factorisation no longer banded. window ≤ 0: no taper.
+/// The overlap of the points of rods laid end to end (rod::RodRange, covering X), tapered along
+/// each rod with the distance d = |j − k| along it (closed: min(|j − k|, n − |j − k|)): block (j, k)
+/// of two points of one rod times max(0, 1 − d/window); of two rods, 0 (as far apart along a rod
+/// as can be). The taper is a positive semi-definite matrix on each rod (its spectrum is a Fejér
+/// kernel; closed rods need n ≥ 2·window), zero between them, so the Schur product stays positive
+/// semi-definite (Schur's product theorem). With a window wider than the kernel's reach along the
+/// rod (4c / spacing points) it keeps each rod's own overlap nearly whole and drops that of
+/// strands far apart along the rod but close in space, which would make the local system's
+/// factorisation no longer banded. window ≤ 0: no taper (the rods are then not read).
 Eigen::SparseMatrix<double> kernel_overlap(std::span<const Vec3> X, const GridSpec& grid, int m,
-                                           double window, bool closed);
+                                           double window,
+                                           const std::vector<rod::RodRange>& rods);
 
 }  // namespace ibrod::integrate

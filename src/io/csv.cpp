@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <limits>
 #include <sstream>
+#include <utility>
 
 #include "core/error.hpp"
 #include "core/text_file.hpp"
@@ -111,27 +112,44 @@ std::string final_state_csv(const rod::RodState& s) {
 }
 
 std::string final_state_csv(const rod::RodState& s, const std::vector<rod::RodRange>& ranges) {
-  if (ranges.size() <= 1) return final_state_csv(s);
+  if (!rod::names_rods(ranges)) return final_state_csv(s);
   std::string out = std::string("rod,") + kStateHeader;  // each row after its rod's number
-  for (std::size_t r = 0; r < ranges.size(); ++r)
-    for (int k = ranges[r].offset; k < ranges[r].offset + ranges[r].n; ++k) {
+  rod::for_each_rod(ranges, [&](std::size_t r, const rod::RodRange& g) {
+    for (int k = g.offset; k < g.offset + g.n; ++k) {
       out += std::to_string(r) + ",";
       append_state_row(out, s.X[k], s.D[k]);
       out += '\n';
     }
+  });
   return out;
 }
 
-std::string rods_header(const std::vector<bool>& closed) {
-  std::string s = "step,time_us";
-  const std::size_t rods = closed.size();
-  for (std::size_t r = 0; r < rods; ++r) {
+std::vector<RodColumn> rod_columns(std::span<const rod::RodRange> rods) {
+  std::vector<RodColumn> c;
+  rod::for_each_rod(rods, [&](std::size_t r, const rod::RodRange&) {
     const std::string k = std::to_string(r);
-    s += ",writhe_" + k + ",twist_" + k + ",link_" + k;
-  }
-  for (std::size_t a = 0; a < rods; ++a)
-    for (std::size_t b = a + 1; b < rods; ++b)
-      if (closed[a] && closed[b]) s += ",link_" + std::to_string(a) + "_" + std::to_string(b);
+    using PerRod = sim::Observables::PerRod;
+    for (auto [name, member] :
+         {std::pair{"writhe_", &PerRod::writhe}, std::pair{"twist_", &PerRod::twist},
+          std::pair{"link_", &PerRod::link}})
+      c.push_back({name + k, [r, member](const sim::Observables& o) { return o.rod(r).*member; }});
+  });
+  std::size_t q = 0;  // the pair's place in Observables::pair_links
+  rod::for_each_pair(rods, [&](std::size_t a, std::size_t b) {
+    if (!rods[a].closed || !rods[b].closed) return;
+    c.push_back(
+        {"link_" + std::to_string(a) + "_" + std::to_string(b), [q](const sim::Observables& o) {
+           return q < o.pair_links.size() ? o.pair_links[q]
+                                          : std::numeric_limits<double>::quiet_NaN();
+         }});
+    ++q;
+  });
+  return c;
+}
+
+std::string rods_header(std::span<const rod::RodRange> rods) {
+  std::string s = "step,time_us";
+  for (const RodColumn& c : rod_columns(rods)) s += "," + c.name;
   return s;
 }
 

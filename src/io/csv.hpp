@@ -3,6 +3,7 @@
 // writers of final_state.csv and of a time series cut back to a checkpoint's step.
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <span>
 #include <string>
 #include <vector>
@@ -42,10 +43,20 @@ std::string final_state_csv(const rod::RodState& s);
 /// the others. One range: exactly final_state_csv(s).
 std::string final_state_csv(const rod::RodState& s, const std::vector<rod::RodRange>& ranges);
 
-/// rods.csv of a run of several rods (docs/outputs.md): step,time_us, then writhe_r,twist_r,link_r
-/// for r = 0 … rods − 1 (an open rod's writhe and link empty), then link_a_b, the linking number of
-/// each pair a < b of closed rods (`closed`: each rod's).
-std::string rods_header(const std::vector<bool>& closed);
+/// A per-rod column of rods.csv: its name and its value in a time-series row (NaN where the row
+/// has none).
+struct RodColumn {
+  std::string name;
+  std::function<double(const sim::Observables&)> value;
+};
+/// The per-rod columns of rods.csv, after step,time_us: writhe_r, twist_r, link_r for each rod r
+/// (an open rod's writhe and link NaN), then link_a_b, the linking number of each pair a < b of
+/// closed rods. The one list rods.csv and the Python module's run columns take.
+std::vector<RodColumn> rod_columns(std::span<const rod::RodRange> rods);
+
+/// rods.csv of a run whose rods rod::names_rods (docs/outputs.md): step,time_us, then the names
+/// of rod_columns(rods).
+std::string rods_header(std::span<const rod::RodRange> rods);
 /// One row of rods.csv from a time-series row (Observables::rods), no newline.
 std::string rods_row(const sim::Observables& o);
 

@@ -59,8 +59,7 @@ std::string rods_vtp(const rod::RodState& s, const std::vector<double>& ds_A,
   const int n = s.size();
   std::vector<double> omega(n), strain(n), rod_of(n);
   std::size_t lines = 0;  // connectivity entries
-  for (std::size_t r = 0; r < ranges.size(); ++r) {
-    const rod::RodRange& g = ranges[r];
+  rod::for_each_rod(ranges, [&](std::size_t r, const rod::RodRange& g) {
     const double ds = ds_A.at(r);
     std::vector<double> om(g.n), st(g.n);  // per half point k+½ of this rod
     for (int k = 0; k < rod::half_points(g.n, g.closed); ++k) {
@@ -79,7 +78,7 @@ std::string rods_vtp(const rod::RodState& s, const std::vector<double>& ds_A,
       rod_of[g.offset + k] = double(r);
     }
     lines += std::size_t(g.n) + (g.closed ? 1 : 0);
-  }
+  });
   std::vector<double> connectivity, offsets;
   connectivity.reserve(lines);
   for (const rod::RodRange& g : ranges) {
@@ -95,7 +94,7 @@ std::string rods_vtp(const rod::RodState& s, const std::vector<double>& ds_A,
       "header_type=\"UInt64\">\n"
       "  <PolyData>\n";
   out += "    <Piece NumberOfPoints=\"" + std::to_string(n) +
-         "\" NumberOfVerts=\"0\" NumberOfLines=\"" + std::to_string(ranges.size()) +
+         "\" NumberOfVerts=\"0\" NumberOfLines=\"" + std::to_string(offsets.size()) +
          "\" NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n";
   out += "      <PointData Scalars=\"twist_density_rad_per_A\" Vectors=\"d3\">\n";
   const char* const triad_names[3] = {"d1", "d2", "d3"};
@@ -128,7 +127,7 @@ std::string rod_vtp(const rod::RodState& s, double ds_A, bool closed) {
 
 std::string rod_vtp(const rod::RodState& s, const std::vector<double>& ds_A,
                     const std::vector<rod::RodRange>& ranges) {
-  return rods_vtp(s, ds_A, ranges, ranges.size() > 1);
+  return rods_vtp(s, ds_A, ranges, rod::names_rods(ranges));
 }
 
 std::string fluid_vti(const GridSpec& g, std::array<const double*, 3> u) {

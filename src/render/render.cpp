@@ -102,6 +102,13 @@ View standard_view(const std::string& name) {
 Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diameter,
                  const View& view, int width, int height, const Style& style,
                  std::span<const Vec3> frame) {
+  const rod::RodRange ring{0, int(X.size()), true};
+  return render_rods(X, d1, {&ring, 1}, diameter, view, width, height, style, frame);
+}
+
+Image render_rods(std::span<const Vec3> X, std::span<const Vec3> d1,
+                  std::span<const rod::RodRange> rods, double diameter, const View& view, int width,
+                  int height, const Style& style, std::span<const Vec3> frame) {
   const std::size_t n = X.size();
   if (n < 2) throw std::invalid_argument("render_rod: needs at least 2 points");
   if (d1.size() != n)
@@ -163,10 +170,8 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
   std::vector<float> param(style.colouring == Colouring::stripe ? 0 : depth.size(), 0.0f);
   // arc length of the nearest hit's axis point from X_0, for the outlines
   std::vector<float> arc(depth.size(), 0.0f);
-  // the rods: one (X, style.closed), or several laid end to end (style.rods); each point's next
-  // and previous point along its rod (−1 past a free end), its rod, and the rods' arc lengths
-  std::vector<rod::RodRange> rods = style.rods;
-  if (rods.empty()) rods.push_back({0, int(n), style.closed});
+  // the rods laid end to end in X: each point's next and previous point along its rod (−1 past a
+  // free end), its rod, and the rods' arc lengths
   {
     std::size_t total = 0;
     for (const rod::RodRange& g : rods) {
@@ -178,21 +183,18 @@ Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diame
   }
   std::vector<long> next(n, -1), prev(n, -1);
   std::vector<int> rod_of(n, 0);
-  std::vector<double> rod_len(rods.size(), 0.0);
-  std::vector<bool> rod_closed(rods.size());
-  {
-    std::size_t off = 0;
-    for (std::size_t r = 0; r < rods.size(); ++r) {
-      const std::size_t m = std::size_t(rods[r].n);
-      rod_closed[r] = rods[r].closed;
-      for (std::size_t k = 0; k < m; ++k) {
-        rod_of[off + k] = int(r);
-        if (k + 1 < m || rods[r].closed) next[off + k] = long(off + (k + 1) % m);
-        if (k > 0 || rods[r].closed) prev[off + k] = long(off + (k + m - 1) % m);
-      }
-      off += m;
+  std::vector<double> rod_len;
+  std::vector<bool> rod_closed;
+  rod::for_each_rod(rods, [&](std::size_t r, const rod::RodRange& g) {
+    const std::size_t off = std::size_t(g.offset), m = std::size_t(g.n);
+    rod_len.push_back(0.0);
+    rod_closed.push_back(g.closed);
+    for (std::size_t k = 0; k < m; ++k) {
+      rod_of[off + k] = int(r);
+      if (k + 1 < m || g.closed) next[off + k] = long(off + (k + 1) % m);
+      if (k > 0 || g.closed) prev[off + k] = long(off + (k + m - 1) % m);
     }
-  }
+  });
   // segments k → next[k]: n of a closed polygon, n − 1 of an open one, per rod
   std::vector<std::size_t> seg;
   for (std::size_t k = 0; k < n; ++k)

@@ -67,21 +67,22 @@ struct Style {
                                     ///< below a quarter of the image width
   bool axis_triad = false;          ///< the lab axes x, y, z at the bottom right
   Rgb ink{40, 40, 40};              ///< labels, scale bar and axis triad
-  bool closed = true;  ///< X is a closed polygon (a ring); false: open (no segment X_{n−1} → X_0)
-  /// The rods' layouts (rod::RodRange: offset, points, closed), laid one after another in X; each
-  /// is its own tube (no segment joins two rods; `closed` above is then unused). Empty: X is one
-  /// rod, closed as `closed` says.
-  std::vector<rod::RodRange> rods;
 };
 
-/// Renders the tube of diameter `diameter` (X's length unit) about the closed polygon X (open
-/// with style.closed = false: capped free ends, no closing segment) with the
+/// Renders the rods `rods` (rod::RodRange: offset, points, closed; laid one after another in X,
+/// covering it), each its own tube of diameter `diameter` (X's length unit) about its polygon (a
+/// closed one a ring; an open one with capped free ends; no segment joins two rods) with the
 /// stripe along d1 (one director per point; interpolated along each segment and projected ⟂ to
 /// it), seen from `view`, into a width × height image. Tight framing: the box that the tube
 /// about the points `frame` (empty: X itself) covers on the image plane is centred and fills
 /// the image less the margins along its limiting side (pass every frame of a movie as `frame`
-/// so that all its pictures share one scale and centre). X.size() ≥ 2 and d1.size() = X.size(),
-/// else std::invalid_argument.
+/// so that all its pictures share one scale and centre). X.size() ≥ 2, d1.size() = X.size() and
+/// the rods laid end to end over X, else std::invalid_argument.
+Image render_rods(std::span<const Vec3> X, std::span<const Vec3> d1,
+                  std::span<const rod::RodRange> rods, double diameter, const View& view,
+                  int width, int height, const Style& style = {},
+                  std::span<const Vec3> frame = {});
+/// render_rods of one closed ring, the whole of X.
 Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diameter,
                  const View& view, int width, int height, const Style& style = {},
                  std::span<const Vec3> frame = {});

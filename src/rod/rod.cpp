@@ -160,6 +160,10 @@ void advance(RodState& s, std::span<const Vec3> U, std::span<const Vec3> W, doub
   }
 }
 
+RodState initial_shape(const RodParams& p, const CircleParams& c) {
+  return p.closed ? twisted_circle(p, c) : straight_rod(p, c.perturbation, c.center);
+}
+
 double circle_radius(int n, double ds) { return n * ds / (2.0 * std::numbers::pi); }
 
 double circle_tilt_sin_beta(double a1, double a3, double b1, double r0, double excess_link) {

@@ -33,6 +33,13 @@ struct RodParams {
 
 /// Number of half points (links k → k+1) of a rod of n points: n closed, n − 1 open.
 inline int half_points(int n, bool closed) { return closed ? n : (n > 0 ? n - 1 : 0); }
+/// The point before k along a rod of n points (closed: n − 1 before 0; open: the first point is
+/// its own, so that a central difference becomes one-sided at a free end).
+inline int point_before(int k, int n, bool closed) {
+  return k > 0 ? k - 1 : closed ? n - 1 : 0;
+}
+/// The point after k (closed: 0 after n − 1; open: the last point is its own).
+inline int point_after(int k, int n, bool closed) { return k + 1 < n ? k + 1 : closed ? 0 : n - 1; }
 
 struct RodState {
   std::vector<Vec3> X;  ///< [n] axis positions, Å (unwrapped: never folded into the box)
@@ -104,6 +111,10 @@ RodState twisted_circle(const RodParams& p, const CircleParams& c);
 /// A stress-free state when p.omega0 = 0 and eps is empty. Throws ConfigError for n < 2 or
 /// ds ≤ 0.
 RodState straight_rod(const RodParams& p, const std::vector<double>& eps, const Vec3& center);
+
+/// A rod's built-in initial shape: the twisted circle of `c` (p.closed) or the straight rod
+/// (open: c's perturbation and centre).
+RodState initial_shape(const RodParams& p, const CircleParams& c);
 
 /// Radius of the circle of n points Δs apart (Å): r0 = n Δs / 2π (MODEL §5).
 double circle_radius(int n, double ds);

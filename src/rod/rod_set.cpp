@@ -15,6 +15,39 @@ std::vector<RodRange> ranges_of(std::span<const RodParams> rods) {
   return r;
 }
 
+int total_points(std::span<const RodRange> rods) {
+  int n = 0;
+  for (const RodRange& r : rods) n += r.n;
+  return n;
+}
+
+int total_points(std::span<const RodParams> rods) {
+  int n = 0;
+  for (const RodParams& r : rods) n += r.n;
+  return n;
+}
+
+bool names_rods(std::span<const RodRange> rods) { return rods.size() > 1; }
+bool names_rods(std::span<const RodParams> rods) { return rods.size() > 1; }
+
+std::string message_prefix(std::span<const RodRange> rods, std::size_t r) {
+  return names_rods(rods) ? "rod " + std::to_string(r) + ": " : std::string();
+}
+std::string message_prefix(std::span<const RodParams> rods, std::size_t r) {
+  return names_rods(rods) ? "rod " + std::to_string(r) + ": " : std::string();
+}
+
+std::string describe(std::span<const RodRange> rods) {
+  return std::to_string(total_points(rods)) + " rod points (rods: " + std::to_string(rods.size()) +
+         ")";
+}
+
+std::string count_label(std::span<const RodRange> rods) {
+  return std::to_string(rods.size()) + " rods";
+}
+
+bool one_ring(std::span<const RodRange> rods) { return rods.size() == 1 && rods[0].closed; }
+
 void extract(const RodState& all, const RodRange& r, RodState& out) {
   if (out.size() != r.n) {
     out.X.resize(r.n);

@@ -4,7 +4,9 @@
 // coupling and the pair forces see one list of points; each rod keeps its own RodParams (its n,
 // Δs, moduli, intrinsic strains, closed or open) and its elastic forces are computed on its own
 // range. The helpers here cut a rod out of the whole state and place a shape in the box.
+#include <cstddef>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "rod/rod.hpp"
@@ -24,6 +26,58 @@ struct RodRange {
 
 /// The ranges of rods laid end to end, in order (each rod's n, closed and Δs).
 std::vector<RodRange> ranges_of(std::span<const RodParams> rods);
+
+// ---- The operations callers outside src/rod take instead of asking how many rods there are
+// (ARCHITECTURE.md "How many places a kind of rod or a count of rods reaches"): they loop over the
+// collection, and one rod is a collection of one.
+
+/// Calls f(r, range) for each rod r of `rods` laid end to end, in order, without allocating
+/// (the ranges ranges_of would return).
+template <class F>
+void for_each_range(std::span<const RodParams> rods, F&& f) {
+  int offset = 0;
+  for (std::size_t r = 0; r < rods.size(); ++r) {
+    f(r, RodRange{offset, rods[r].n, rods[r].closed, rods[r].ds});
+    offset += rods[r].n;
+  }
+}
+/// Calls f(r, range) for each rod r, in order.
+template <class F>
+void for_each_rod(std::span<const RodRange> rods, F&& f) {
+  for (std::size_t r = 0; r < rods.size(); ++r) f(r, rods[r]);
+}
+/// Calls f(a, b) for each pair of rods a < b, in the order (0,1), (0,2), …, (1,2), … (none for a
+/// collection of one): the pair links, the contacts between rods.
+template <class F>
+void for_each_pair(std::span<const RodRange> rods, F&& f) {
+  for (std::size_t a = 0; a < rods.size(); ++a)
+    for (std::size_t b = a + 1; b < rods.size(); ++b) f(a, b);
+}
+
+/// The rods' points together.
+int total_points(std::span<const RodRange> rods);
+int total_points(std::span<const RodParams> rods);
+
+/// Whether the files and messages of a run of these rods name each rod: a `rod` column in
+/// final_state.csv, the .vtp and the H5MD species, rods.csv (each rod's writhe, twist and link),
+/// "rod r: " before what is wrong with rod r, "N rods" in a picture's label. A collection of one
+/// names none: its files are those of the one rod runs wrote before there were several (and so
+/// stay byte-identical; its per-rod values are the totals). The one place that layout is decided.
+bool names_rods(std::span<const RodRange> rods);
+bool names_rods(std::span<const RodParams> rods);
+
+/// "rod r: " where names_rods(rods), else "": what heads a message about rod r.
+std::string message_prefix(std::span<const RodRange> rods, std::size_t r);
+std::string message_prefix(std::span<const RodParams> rods, std::size_t r);
+
+/// "N rod points (rods: K)": the collection in a run's first line.
+std::string describe(std::span<const RodRange> rods);
+/// "K rods": the collection in a picture's label.
+std::string count_label(std::span<const RodRange> rods);
+
+/// Whether the collection is one closed curve: what the shape classes (diagnostics::shape: lobes,
+/// two-ply runs; of one ring) and the excess link of `[rod]` describe.
+bool one_ring(std::span<const RodRange> rods);
 
 /// Copies rod r's positions and triads out of the whole state into `out` (resized only when its
 /// size differs, so a reused `out` allocates nothing).

@@ -74,8 +74,7 @@ std::string state_problem(const rod::RodState& s, int n, double ds, bool closed)
   // D³ along the rod: an orthonormal triad with its rows and columns swapped passes the checks
   // above, and the run then blows up at its first step
   for (int k = 0; k < n; ++k) {
-    const int prev = k > 0 ? k - 1 : closed ? n - 1 : 0;
-    const int next = k + 1 < n ? k + 1 : closed ? 0 : n - 1;
+    const int prev = rod::point_before(k, n, closed), next = rod::point_after(k, n, closed);
     const Vec3 t = s.X[next] - s.X[prev];  // central; one-sided at an open rod's ends
     const double c = t.dot(s.D[k].col(2)) / t.norm();
     if (!(c >= kMinTangentCosine)) {
@@ -93,71 +92,68 @@ std::string state_problem(const rod::RodState& s, int n, double ds, bool closed)
 }
 
 namespace {
-int total_points(std::span<const rod::RodParams> rods) {
-  int n = 0;
-  for (const rod::RodParams& r : rods) n += r.n;
-  return n;
+// What is wrong with a state whose count of points is not the rods' total, "" if nothing.
+std::string count_problem(std::span<const rod::RodParams> rods, const rod::RodState& s) {
+  const int n = rod::total_points(rods);
+  if (s.size() == n && int(s.D.size()) == n) return {};
+  return std::to_string(s.size()) + " positions and " + std::to_string(s.D.size()) + " triads; " +
+         (rod::names_rods(rods) ? "the rods have " + std::to_string(n) + " points together"
+                                : "the rod has " + std::to_string(n) + " points (rod.base_pairs)");
 }
 }  // namespace
 
 std::string rods_problem(std::span<const rod::RodParams> rods, const rod::RodState& s,
                          std::span<const double> tolerances) {
-  if (rods.size() == 1) return rod_problem(s, rods[0].ds, tolerances[0], rods[0].closed);
-  const int n = total_points(rods);
-  if (s.size() != n || int(s.D.size()) != n)
-    return std::to_string(s.size()) + " positions and " + std::to_string(s.D.size()) +
-           " triads; the rods have " + std::to_string(n) + " points";
+  if (std::string bad = count_problem(rods, s); !bad.empty()) return bad;
   const std::span<const Vec3> X(s.X);
   const std::span<const Mat3> D(s.D);
-  std::size_t offset = 0;
-  for (std::size_t r = 0; r < rods.size(); ++r) {
-    const std::size_t m = std::size_t(rods[r].n);
-    if (std::string bad = rod_problem(X.subspan(offset, m), D.subspan(offset, m), rods[r].ds,
-                                      tolerances[r], rods[r].closed);
-        !bad.empty())
-      return "rod " + std::to_string(r) + ": " + bad;
-    offset += m;
-  }
-  return {};
+  std::string bad;  // the first rod's problem
+  rod::for_each_range(rods, [&](std::size_t r, const rod::RodRange& g) {
+    const std::size_t at = std::size_t(g.offset), m = std::size_t(g.n);
+    if (!bad.empty()) return;
+    if (std::string b =
+            rod_problem(X.subspan(at, m), D.subspan(at, m), g.ds, tolerances[r], g.closed);
+        !b.empty())
+      bad = rod::message_prefix(rods, r) + b;
+  });
+  return bad;
 }
 
 std::string rods_state_problem(std::span<const rod::RodParams> rods, const rod::RodState& s,
                                double box) {
-  if (rods.size() == 1) return state_problem(s, rods[0].n, rods[0].ds, rods[0].closed);
-  const int n = total_points(rods);
-  if (s.size() != n || int(s.D.size()) != n)
-    return std::to_string(s.size()) + " positions and " + std::to_string(s.D.size()) +
-           " triads; the rods have " + std::to_string(n) + " points together";
-  rod::RodState one;
+  if (std::string bad = count_problem(rods, s); !bad.empty()) return bad;
   const std::vector<rod::RodRange> ranges = rod::ranges_of(rods);
-  for (std::size_t r = 0; r < rods.size(); ++r) {
-    rod::extract(s, ranges[r], one);
-    if (std::string bad = state_problem(one, rods[r].n, rods[r].ds, rods[r].closed); !bad.empty())
-      return "rod " + std::to_string(r) + ": " + bad;
-  }
+  std::string bad;  // the first problem found
+  rod::RodState one;
+  rod::for_each_rod(ranges, [&](std::size_t r, const rod::RodRange& g) {
+    if (!bad.empty()) return;
+    rod::extract(s, g, one);
+    if (std::string b = state_problem(one, g.n, g.ds, g.closed); !b.empty())
+      bad = rod::message_prefix(ranges, r) + b;
+  });
   // two rods must not start on top of each other (coincident charges, crossed hard cores)
-  for (std::size_t a = 0; a < rods.size(); ++a)
-    for (std::size_t b = a + 1; b < rods.size(); ++b) {
-      const double min_d = 0.5 * std::min(rods[a].ds, rods[b].ds);
-      for (int i = 0; i < ranges[a].n; ++i)
-        for (int j = 0; j < ranges[b].n; ++j) {
-          Vec3 v = s.X[ranges[a].offset + i] - s.X[ranges[b].offset + j];
-          // the box is periodic: a rod on another's periodic image lies on it in the fluid
-          if (box > 0) v -= box * (v / box).array().round().matrix();
-          const double d = v.norm();
-          if (!(d >= min_d)) {
-            char buf[400];
-            std::snprintf(buf, sizeof buf,
-                          "rods %zu and %zu overlap: point %d of rod %zu and point %d of rod %zu "
-                          "are %.3g Å apart%s (at least half a rise, %.3g Å, needed; place the "
-                          "rods apart with rod.offset_A)",
-                          a, b, i, a, j, b, d / units::angstrom,
-                          box > 0 ? " in the periodic box" : "", min_d / units::angstrom);
-            return buf;
-          }
+  rod::for_each_pair(ranges, [&](std::size_t a, std::size_t b) {
+    const rod::RodRange &ga = ranges[a], &gb = ranges[b];
+    const double min_d = 0.5 * std::min(ga.ds, gb.ds);
+    for (int i = 0; i < ga.n && bad.empty(); ++i)
+      for (int j = 0; j < gb.n && bad.empty(); ++j) {
+        Vec3 v = s.X[ga.offset + i] - s.X[gb.offset + j];
+        // the box is periodic: a rod on another's periodic image lies on it in the fluid
+        if (box > 0) v -= box * (v / box).array().round().matrix();
+        const double d = v.norm();
+        if (!(d >= min_d)) {
+          char buf[400];
+          std::snprintf(buf, sizeof buf,
+                        "rods %zu and %zu overlap: point %d of rod %zu and point %d of rod %zu "
+                        "are %.3g Å apart%s (at least half a rise, %.3g Å, needed; place the "
+                        "rods apart with rod.offset_A)",
+                        a, b, i, a, j, b, d / units::angstrom,
+                        box > 0 ? " in the periodic box" : "", min_d / units::angstrom);
+          bad = buf;
         }
-    }
-  return {};
+      }
+  });
+  return bad;
 }
 
 }  // namespace ibrod::sim

@@ -32,9 +32,9 @@ std::string state_problem(const rod::RodState& s, int n, double ds, bool closed 
 /// The same for the rods of a state of one or several rods laid end to end (rod::RodRange): each
 /// rod checked in place on its own points with its own Δs, end condition and spacing tolerance
 /// (`tolerances`, one per rod: spacing_tolerance(rod, thermal_kT), computed once per run); with
-/// several rods "rod r: " heads what is wrong and point numbers count within that rod. One rod:
-/// exactly rod_problem / state_problem. A state whose size is not the rods' total is a problem
-/// too. O(n), no allocation: the blow-up guard after every step.
+/// several rods (rod::names_rods) "rod r: " heads what is wrong and point numbers count within
+/// that rod; one rod: what rod_problem / state_problem find. A state whose size is not the rods'
+/// total is a problem too. O(n), no allocation: the blow-up guard after every step.
 std::string rods_problem(std::span<const rod::RodParams> rods, const rod::RodState& s,
                          std::span<const double> tolerances);
 /// box > 0: the edge of the periodic box (internal units); two rods overlap if any of their points

@@ -88,12 +88,10 @@ SimParams checked(SimParams p) {
   }
   return p;
 }
-// One rod's initial shape: the twisted circle (closed) or the straight rod (open), turned about
-// its centroid by R.
+// One rod's initial shape (rod::initial_shape: the twisted circle or the straight rod), turned
+// about its centroid by R.
 rod::RodState shape_of(const rod::RodParams& rp, const SimParams::Shape& shape) {
-  const rod::CircleParams& c = shape.circle;
-  rod::RodState s =
-      rp.closed ? rod::twisted_circle(rp, c) : rod::straight_rod(rp, c.perturbation, c.center);
+  rod::RodState s = rod::initial_shape(rp, shape.circle);
   if (!shape.rotation.isIdentity(0)) rod::place(s, shape.rotation, Vec3::Zero());
   return s;
 }
@@ -102,32 +100,26 @@ rod::RodState shape_of(const rod::RodParams& rp, const SimParams::Shape& shape) 
 
 rod::RodState initial_state(const SimParams& p) {
   rod::RodState s;
-  for (std::size_t r = 0; r < p.stepper.rods.size(); ++r)
-    rod::append(s, shape_of(p.stepper.rods[r], p.shapes[r]));
+  rod::for_each_range(p.stepper.rods, [&](std::size_t r, const rod::RodRange&) {
+    rod::append(s, shape_of(p.stepper.rods[r], p.shapes.at(r)));
+  });
   return s;
 }
 
 Simulation::Simulation(const SimParams& p)
     : p_(checked(p)), rod_(initial_state(p_)), system_(p_.stepper) {
-  const std::vector<rod::RodParams>& rods = this->rods();
   const std::vector<rod::RodRange>& ranges = rod_ranges();
   // docs/thermal.md: with noise a segment's thermal stretch alone may pass 50 %
-  for (const rod::RodParams& r : rods)
+  for (const rod::RodParams& r : rods())
     tolerances_.push_back(spacing_tolerance(r, p_.stepper.fluid.thermal_kT));
   // MODEL §6: the electrostatic energy is also reported relative to the circle at the same salt.
   // The unperturbed circle (perturbation only rotates triads, so X is the same); for an open rod
-  // the straight rod.
-  // Several rods: the sum of each rod's own shape alone (rods placed anywhere, even on top of
-  // each other before rod.initial_shape moves them, give the same reference).
-  if (p_.stepper.electro.enabled && rods.size() == 1)
-    electro_circle_ = system_.electrostatics().energy(rod_.X);
-  if (p_.stepper.electro.enabled && rods.size() > 1) {
-    rod::RodState one;
-    for (const rod::RodRange& g : ranges) {
-      rod::extract(rod_, g, one);
-      electro_circle_ += interactions::Electrostatics(p_.stepper.electro, g.n).energy(one.X);
-    }
-  }
+  // the straight rod. Several rods: the sum of each rod's own shape alone (rods placed anywhere,
+  // even on top of each other before rod.initial_shape moves them, give the same reference).
+  if (p_.stepper.electro.enabled)
+    for (const rod::RodRange& g : ranges)
+      electro_circle_ += system_.electrostatics().energy(
+          std::span<const Vec3>(rod_.X).subspan(std::size_t(g.offset), std::size_t(g.n)));
   if (p_.scheme == TimeScheme::implicit_step) {
     auto imp = std::make_unique<integrate::ImplicitIntegrator>(system_, p_.implicit, p_.adaptive);
     implicit_ = imp.get();
@@ -228,35 +220,6 @@ void Simulation::step() {
   ++step_;
 }
 
-namespace {
-struct Topology {
-  double writhe, twist, link, closest, spacing;  // spacing: the mean, Å
-  int links;
-};
-
-// One rod's writhe, twist, link (NaN where not defined), closest approach and summed spacing.
-Topology topology_of(const rod::RodState& s, bool closed, int min_separation) {
-  const int n = s.size();
-  std::vector<Vec3> d1(n);
-  for (int k = 0; k < n; ++k) d1[k] = s.D[k].col(0);
-  Topology t{};
-  if (closed) {
-    t.writhe = diagnostics::writhe(s.X);
-    t.twist = diagnostics::twist(s.X, d1);
-    t.link = t.writhe + t.twist;
-  } else {
-    // docs/model.md "Open rods": no link or writhe (not topological with free ends); NaN here is
-    // "not defined", written as an empty CSV field and null in JSON (io/observables)
-    t.writhe = t.link = std::numeric_limits<double>::quiet_NaN();
-    t.twist = diagnostics::twist_open(s.X, d1);
-  }
-  t.closest = diagnostics::closest_approach(s.X, min_separation, closed);
-  t.links = rod::half_points(n, closed);
-  t.spacing = diagnostics::mean_spacing(s.X, closed);
-  return t;
-}
-}  // namespace
-
 Observables Simulation::observe() {
   const double kT = p_.kT;
   Observables o;
@@ -271,49 +234,65 @@ Observables Simulation::observe() {
   o.E_steric_kT = E.steric / kT;
   o.E_kinetic_kT = system_.fluid_kinetic_energy() / kT;  // collective when distributed
   o.E_total_kT = E.potential_kT(kT) + o.E_kinetic_kT;    // the one sum (StepEnergies::terms)
-  const std::vector<rod::RodParams>& rods = this->rods();
-  const std::vector<rod::RodRange>& ranges = rod_ranges();
 
-  if (rods.size() == 1) {
-    const Topology t = topology_of(rod_, rods[0].closed, p_.closest_min_separation);
-    o.writhe = t.writhe;
-    o.twist = t.twist;
-    o.link = t.link;
-    o.closest_approach_A = t.closest;
-    o.bp_spacing_A = t.spacing;
-    o.rods.push_back({t.writhe, t.twist, t.link});  // a collection of one: its rod's are the totals
-    return o;
-  }
-  // several rods: each rod's own, summed; the closest approach also over pairs of rods
-  double spacing = 0, closest = HUGE_VAL;
+  // each rod's own (o.rods, always filled), summed (a sum of writhe(), twist() from +0 is never
+  // −0, so one rod's totals are its own values bitwise); the closest approach over each rod's own
+  // pairs and every pair of points of different rods; the spacing the mean over all links,
+  // folded rod by rod as a weighted mean (no links yet: the rod's own mean)
+  const std::vector<rod::RodRange>& ranges = rod_ranges();
+  const std::span<const Vec3> X(rod_.X);
+  const std::span<const Mat3> D(rod_.D);
+  double closest = HUGE_VAL;
   int links = 0;
-  rod::RodState one;
-  for (std::size_t r = 0; r < rods.size(); ++r) {
-    rod::extract(rod_, ranges[r], one);
-    const Topology t = topology_of(one, rods[r].closed, p_.closest_min_separation);
+  std::vector<Vec3> d1;  // a rod's directors D¹
+  for (const rod::RodRange& g : ranges) {
+    const std::size_t at = std::size_t(g.offset), n = std::size_t(g.n);
+    d1.resize(n);
+    for (std::size_t k = 0; k < n; ++k) d1[k] = D[at + k].col(0);
+    const diagnostics::RodTopology t =
+        diagnostics::rod_topology(X.subspan(at, n), d1, g.closed, p_.closest_min_separation);
     o.rods.push_back({t.writhe, t.twist, t.link});
     o.writhe += t.writhe;
     o.twist += t.twist;
     o.link += t.link;
     if (std::isfinite(t.closest)) closest = std::min(closest, t.closest);
-    spacing += t.spacing * t.links;
+    o.bp_spacing_A =
+        links == 0 ? t.spacing : (o.bp_spacing_A * links + t.spacing * t.links) / (links + t.links);
     links += t.links;
   }
-  for (std::size_t a = 0; a < rods.size(); ++a)
-    for (std::size_t b = a + 1; b < rods.size(); ++b)
-      for (int i = 0; i < ranges[a].n; ++i)
-        for (int j = 0; j < ranges[b].n; ++j)
-          closest = std::min(closest,
-                             (rod_.X[ranges[a].offset + i] - rod_.X[ranges[b].offset + j]).norm());
+  rod::for_each_pair(ranges, [&](std::size_t a, std::size_t b) {
+    const rod::RodRange &ga = ranges[a], &gb = ranges[b];
+    for (int i = 0; i < ga.n; ++i)
+      for (int j = 0; j < gb.n; ++j)
+        closest = std::min(closest, (X[ga.offset + i] - X[gb.offset + j]).norm());
+    if (ga.closed && gb.closed)
+      o.pair_links.push_back(
+          diagnostics::linking_number(X.subspan(std::size_t(ga.offset), std::size_t(ga.n)),
+                                      X.subspan(std::size_t(gb.offset), std::size_t(gb.n))));
+  });
   o.closest_approach_A = closest;
-  o.bp_spacing_A = links > 0 ? spacing / links : 0.0;
-  for (std::size_t a = 0; a < rods.size(); ++a)
-    for (std::size_t b = a + 1; b < rods.size(); ++b)
-      if (rods[a].closed && rods[b].closed)
-        o.pair_links.push_back(diagnostics::linking_number(
-            std::span<const Vec3>(rod_.X).subspan(ranges[a].offset, ranges[a].n),
-            std::span<const Vec3>(rod_.X).subspan(ranges[b].offset, ranges[b].n)));
   return o;
+}
+
+Observables::PerRod Observables::rod(std::size_t r) const {
+  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+  return r < rods.size() ? rods[r] : PerRod{nan, nan, nan};
+}
+
+double link_drift(const Observables& now, const Observables& initial) {
+  double drift = std::numeric_limits<double>::quiet_NaN();
+  const auto take = [&](double link, double link0) {
+    if (!std::isfinite(link)) return;  // an open rod has no linking number to conserve
+    drift = std::isnan(drift) ? std::abs(link - link0) : std::max(drift, std::abs(link - link0));
+  };
+  // each closed rod's own link (a passage between two rings changes neither)
+  for (std::size_t r = 0; r < now.rods.size() && r < initial.rods.size(); ++r)
+    take(now.rods[r].link, initial.rods[r].link);
+  if (initial.rods.empty()) take(now.link, initial.link);  // the initial row of a checkpoint
+  // and each pair's linking number: one rod passing through another changes it
+  for (std::size_t q = 0; q < now.pair_links.size() && q < initial.pair_links.size(); ++q)
+    take(now.pair_links[q], initial.pair_links[q]);
+  return drift;
 }
 
 double Simulation::total_energy_kT() {

@@ -86,11 +86,19 @@ struct Observables {
     double writhe = 0, twist = 0, link = 0;
   };
   std::vector<PerRod> rods;
+  /// Rod r's entry; NaNs where the row has none (an initial row read back from a checkpoint).
+  PerRod rod(std::size_t r) const;
   /// Several rods: the Gauss linking number of each pair a < b of closed rods, in the order
   /// (0,1), (0,2), …, (1,2), …; a topological invariant like each rod's link (a passage of one
   /// rod through another changes it). Empty for one rod.
   std::vector<double> pair_links;
 };
+
+/// The largest drift of a conserved linking number from `initial` to `now`: each closed rod's
+/// own link (o.rods) and each pair's (o.pair_links), against the initial row's; where the initial
+/// row has no per-rod values (a checkpoint keeps the columns only: after a resume), the total
+/// link instead (a collection of one: its rod's link). NaN where none is defined (open rods).
+double link_drift(const Observables& now, const Observables& initial);
 
 /// The dynamical state of a trajectory, all that a Simulation of the same parameters needs to go
 /// on bitwise as the one it was taken from: what a checkpoint keeps (written and read back on

@@ -41,8 +41,7 @@ void kick(rod::RodState& s, bool closed, const StabilityProbe& p, std::mt19937_6
     const Vec3 e1 = eig.eigenvectors().col(2), e2 = eig.eigenvectors().col(1);
     // central differences; one-sided at the free ends of an open rod
     auto tangent = [&](const std::vector<Vec3>& X, int k) {
-      const int a = closed ? (k + n - 1) % n : std::max(k - 1, 0);
-      const int b = closed ? (k + 1) % n : std::min(k + 1, n - 1);
+      const int a = rod::point_before(k, n, closed), b = rod::point_after(k, n, closed);
       return Vec3(X[std::size_t(b)] - X[std::size_t(a)]).normalized();
     };
     std::vector<Vec3> X = s.X;

@@ -132,7 +132,7 @@ TEST(Sweep, AKeyOfARodsTableIsSweptLikeAnyKey) {
   ASSERT_EQ(sw.points.size(), 2u);
   for (std::size_t i = 0; i < 2; ++i) {
     const config::Config& c = sw.points[i].config;
-    ASSERT_EQ(config::rod_count(c), 3);
+    ASSERT_EQ(config::rod_configs(c).size(), 3u);
     EXPECT_EQ(config::rod_config(c, 0).rod_excess_link, 0);
     EXPECT_EQ(config::rod_config(c, 1).rod_excess_link, int(i));
     EXPECT_EQ(config::rod_config(c, 1).rod_offset_A[2], 60.0);

@@ -100,7 +100,8 @@ TEST(KernelOverlap, TheChainTaperKeepsItPositiveAndDropsDistantStrands) {
   for (int k = 0; k < n / 2; ++k) X.emplace_back(20.0 + 3.0 * (n / 2 - 1 - k), 65.0, 52.0);
   const double window = 30;
   const Eigen::SparseMatrix<double> O = kernel_overlap(X, grid, 1);
-  const Eigen::SparseMatrix<double> T = kernel_overlap(X, grid, 1, window, true);
+  const std::vector<rod::RodRange> ring = {{0, n, true, 3.0}};
+  const Eigen::SparseMatrix<double> T = kernel_overlap(X, grid, 1, window, ring);
   int across = 0;
   for (int j = 0; j < n; ++j)
     for (int k = 0; k < n; ++k) {
@@ -114,7 +115,35 @@ TEST(KernelOverlap, TheChainTaperKeepsItPositiveAndDropsDistantStrands) {
   EXPECT_GT(across, 100);  // the folded strands overlap, and the taper drops them
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(Eigen::MatrixXd(T), Eigen::EigenvaluesOnly);
   EXPECT_GT(es.eigenvalues().minCoeff(), -1e-12 * es.eigenvalues().maxCoeff());
-  EXPECT_THROW(kernel_overlap(X, grid, 1, 41.0, true), std::invalid_argument);  // n < 2 window
+  EXPECT_THROW(kernel_overlap(X, grid, 1, 41.0, ring), std::invalid_argument);  // n < 2 window
+}
+
+TEST(KernelOverlap, TheTaperOverSeveralRodsDropsEveryPairOfTwoRods) {
+  // two open rods side by side, 12 Å apart (their stencils overlap): tapered along each rod,
+  // nothing between them, still positive semi-definite
+  const GridSpec grid{16, 160.0};
+  std::vector<Vec3> X;
+  for (int k = 0; k < 30; ++k) X.emplace_back(20.0 + 3.0 * k, 50.0, 50.0);
+  for (int k = 0; k < 20; ++k) X.emplace_back(20.0 + 3.0 * k, 62.0, 51.0);
+  const std::vector<rod::RodRange> rods = {{0, 30, false, 3.0}, {30, 20, false, 3.0}};
+  const double window = 8;
+  const Eigen::SparseMatrix<double> O = kernel_overlap(X, grid, 1);
+  const Eigen::SparseMatrix<double> T = kernel_overlap(X, grid, 1, window, rods);
+  int across = 0;
+  for (int j = 0; j < 50; ++j)
+    for (int k = 0; k < 50; ++k) {
+      const bool same = (j < 30) == (k < 30);
+      const double f = same ? std::max(0.0, 1 - std::abs(j - k) / window) : 0.0;
+      const Eigen::MatrixXd bo = Eigen::MatrixXd(O.block(6 * j, 6 * k, 6, 6));
+      const Eigen::MatrixXd bt = Eigen::MatrixXd(T.block(6 * j, 6 * k, 6, 6));
+      ASSERT_LT((bt - f * bo).norm(), 1e-12 * (1 + bo.norm())) << j << " " << k;
+      across += !same && bo.norm() > 0;
+    }
+  EXPECT_GT(across, 50);  // the rods' stencils overlap, and the taper drops them
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(Eigen::MatrixXd(T), Eigen::EigenvaluesOnly);
+  EXPECT_GT(es.eigenvalues().minCoeff(), -1e-12 * es.eigenvalues().maxCoeff());
+  // the rods must cover X
+  EXPECT_THROW(kernel_overlap(X, grid, 1, window, {{0, 30, false, 3.0}}), std::invalid_argument);
 }
 
 TEST(KernelOverlap, RefusesAKernelWiderThanTheGrid) {

@@ -40,7 +40,7 @@ config::Config two_rings() {
 TEST(SeveralRods, ConfigTablesResolveOnTopOfRod) {
   config::Config c = two_rings();
   config::validate(c);
-  EXPECT_EQ(config::rod_count(c), 2);
+  EXPECT_EQ(config::rod_configs(c).size(), 2u);
   EXPECT_EQ(config::point_count(c), 76);
   const config::Config r0 = config::rod_config(c, 0), r1 = config::rod_config(c, 1);
   EXPECT_EQ(r0.rod_base_pairs, 40);  // from [rod]
@@ -64,7 +64,7 @@ TEST(SeveralRods, ConfigTablesResolveOnTopOfRod) {
       "[rod]\nbase_pairs = 50\n[[rods]]\nexcess_link = 0\n[[rods]]\nbase_pairs = 30\n"
       "closed = false\nexcess_link = 0\n",
       "f.toml");
-  EXPECT_EQ(config::rod_count(f), 2);
+  EXPECT_EQ(config::rod_configs(f).size(), 2u);
   EXPECT_EQ(config::rod_config(f, 0).rod_base_pairs, 50);
   EXPECT_FALSE(config::rod_config(f, 1).rod_closed);
   EXPECT_EQ(config::point_count(f), 80);

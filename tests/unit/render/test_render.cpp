@@ -457,13 +457,11 @@ TEST(Render, SeveralRodsAreSeparateTubes) {
       X.emplace_back(-100.0 + 200.0 * k / 59, r == 0 ? -60.0 : 60.0, 0.0);
       d1.emplace_back(0, 0, 1);
     }
-  Style two;
-  two.rods = {{0, 60, false}, {60, 60, false}};
-  Style one;
-  one.closed = false;
+  const std::vector<rod::RodRange> two = {{0, 60, false}, {60, 60, false}};
+  const std::vector<rod::RodRange> one = {{0, 120, false}};
   const int w = 200, h = 200;
-  const Image a = render_rod(X, d1, 20.0, standard_view("top"), w, h, two);
-  const Image b = render_rod(X, d1, 20.0, standard_view("top"), w, h, one);
+  const Image a = render_rods(X, d1, two, 20.0, standard_view("top"), w, h);
+  const Image b = render_rods(X, d1, one, 20.0, standard_view("top"), w, h);
   // the image's middle row: between the rods
   int joined = 0, apart = 0;
   for (int x = 0; x < w; ++x) {
@@ -476,9 +474,8 @@ TEST(Render, SeveralRodsAreSeparateTubes) {
   int rods = 0;
   for (int y = 0; y < h; ++y) rods += !is_background(a.at(w / 2, y));
   EXPECT_GT(rods, 10);
-  Style bad = two;
-  bad.rods = {{0, 60, false}, {60, 50, false}};
-  EXPECT_THROW(render_rod(X, d1, 20.0, standard_view("top"), w, h, bad), std::invalid_argument);
+  const std::vector<rod::RodRange> bad = {{0, 60, false}, {60, 50, false}};
+  EXPECT_THROW(render_rods(X, d1, bad, 20.0, standard_view("top"), w, h), std::invalid_argument);
 }
 }  // namespace
 }  // namespace ibrod::render
