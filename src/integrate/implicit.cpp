@@ -192,7 +192,7 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
       for (std::size_t k = 0; k < s.X.size() && !moved; ++k)
         moved = (s.X[k] - X_K_[k]).squaredNorm() > d2;
     }
-    if (moved) {
+    if (moved && steps_since_jacobian_ != 0) {  // (a refresh due anyway is not early)
       steps_since_jacobian_ = 0;
       ++timings_.moved_refreshes;
     }
