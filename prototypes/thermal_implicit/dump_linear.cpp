@@ -75,18 +75,7 @@ int main(int argc, char** argv) {
   integrate::ImplicitStepper imp(st.system(), ip);
   const int n = s.size(), N = 6 * n;
   // M, column by column
-  Eigen::MatrixXd M(N, N);
-  std::vector<Vec3> F(n), T(n), U(n), W(n);
-  for (int c = 0; c < N; ++c) {
-    std::fill(F.begin(), F.end(), Vec3::Zero());
-    std::fill(T.begin(), T.end(), Vec3::Zero());
-    (c % 6 < 3 ? F : T)[c / 6][c % 3] = 1.0;
-    imp.mobility(s.X, F, T, U, W);
-    for (int k = 0; k < n; ++k) {
-      M.block<3, 1>(6 * k, c) = U[k];
-      M.block<3, 1>(6 * k + 3, c) = W[k];
-    }
-  }
+  Eigen::MatrixXd M = imp.mobility_matrix(s.X);
   // M_loc = β D O D (ImplicitStepper's scaling: the self blocks at a generic point)
   const double h = p.stepper.grid.h();
   const std::vector<Vec3> X1{Vec3(0.31, 0.57, 0.73) * h};

@@ -93,6 +93,23 @@ void ImplicitStepper::mobility(std::span<const Vec3> X, std::span<const Vec3> F,
   pc.finish_interpolation(U, W);
 }
 
+Eigen::MatrixXd ImplicitStepper::mobility_matrix(std::span<const Vec3> X) {
+  const int n = int(X.size()), N = 6 * n;
+  Eigen::MatrixXd M(N, N);
+  std::vector<Vec3> F(n), T(n), U(n), W(n);
+  for (int c = 0; c < N; ++c) {
+    std::fill(F.begin(), F.end(), Vec3::Zero());
+    std::fill(T.begin(), T.end(), Vec3::Zero());
+    (c % 6 < 3 ? F : T)[c / 6][c % 3] = 1.0;
+    mobility(X, F, T, U, W);
+    for (int k = 0; k < n; ++k) {
+      M.block<3, 1>(6 * k, c) = U[k];
+      M.block<3, 1>(6 * k + 3, c) = W[k];
+    }
+  }
+  return M;
+}
+
 namespace {
 double now() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();

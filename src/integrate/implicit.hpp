@@ -158,6 +158,9 @@ class ImplicitStepper {
   /// ρ dropped). Å s⁻¹, s⁻¹.
   void mobility(std::span<const Vec3> X, std::span<const Vec3> F, std::span<const Vec3> T,
                 std::span<Vec3> U, std::span<Vec3> W);
+  /// M as a dense [6n × 6n] matrix at X, per point (x, y, z, θx, θy, θz): one Stokes solve per
+  /// column (for tests and prototypes: O(n) solves)
+  Eigen::MatrixXd mobility_matrix(std::span<const Vec3> X);
 
   /// The elastic stiffness at s, [6n × 6n] over all rods' points, per point (x, y, z, θx, θy,
   /// θz), each rod's blocks on its own range (no link past an open rod's ends); units g s⁻²,

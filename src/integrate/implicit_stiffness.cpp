@@ -14,6 +14,8 @@
 
 namespace ibrod::integrate {
 
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+
 namespace {
 
 using Eigen::VectorXd;
@@ -39,7 +41,7 @@ std::vector<int> colouring(int n, bool closed) {
 
 // C = diag(b1, b2, b3, a1, a2, a3) of half point h: the link's moduli (rod.moduli_file) or the
 // scalars.
-Eigen::Matrix<double, 6, 1> moduli(const rod::RodParams& rp, int h) {
+Vec6 moduli(const rod::RodParams& rp, int h) {
   const Vec3& a = rp.a_k.empty() ? rp.a : rp.a_k[h];
   const Vec3& b = rp.b_k.empty() ? rp.b : rp.b_k[h];
   Eigen::Matrix<double, 6, 1> c;
@@ -62,6 +64,25 @@ void link_jacobians(const Mat3& Dh, const Vec3& xp, double ds, Mat6& JL, Mat6& J
   JR.block<3, 3>(0, 3) = 0.5 * G;
   JL.block<3, 3>(3, 3) = -Dh.transpose() / ds;
   JR.block<3, 3>(3, 3) = Dh.transpose() / ds;
+}
+
+/// Calls fn(a, b, ds, c, JL, JR) for every link h of every rod (its points a and b, the rod's Δs,
+/// the link's moduli c = (b1, b2, b3, a1, a2, a3) and the strain Jacobians ∂(Γ, Ω)/∂q_a,
+/// ∂(Γ, Ω)/∂q_b at s): the one walk of the Gauss–Newton K and of its thermal force.
+template <class Fn>
+void for_each_link(const std::vector<rod::RodParams>& rods,
+                   const std::vector<rod::RodRange>& ranges, const rod::RodState& s, Fn&& fn) {
+  for (std::size_t r = 0; r < rods.size(); ++r) {
+    const rod::RodParams& rp = rods[r];
+    const rod::RodRange& g = ranges[r];
+    for (int h = 0; h < rod::half_points(g.n, g.closed); ++h) {
+      const int a = g.offset + h, b = g.offset + (h + 1) % g.n;
+      Mat6 JL, JR;
+      link_jacobians(rod::half_point_triad(s.D[a], s.D[b]), (s.X[b] - s.X[a]) / rp.ds, rp.ds, JL,
+                     JR);
+      fn(a, b, rp.ds, moduli(rp, h), JL, JR);
+    }
+  }
 }
 
 }  // namespace
@@ -170,22 +191,13 @@ void ImplicitStepper::gn_blocks(const rod::RodState& s) {
   // tests/unit/integrate/test_implicit_parts.cpp compares it with the finite-difference K.
   Kd_.assign(n_, Mat6::Zero());
   Ko_.assign(n_, Mat6::Zero());
-  for (std::size_t r = 0; r < rods_.size(); ++r) {
-    const rod::RodParams& rp = rods_[r];
-    const rod::RodRange& g = ranges_[r];
-    for (int h = 0; h < rod::half_points(g.n, g.closed); ++h) {
-      const int a = g.offset + h, b = g.offset + (h + 1) % g.n;
-      const Eigen::Matrix<double, 6, 1> c = moduli(rp, h);
-      const Mat3 Dh = rod::half_point_triad(s.D[a], s.D[b]);
-      const Vec3 xp = (s.X[b] - s.X[a]) / rp.ds;
-      Mat6 JL, JR;  // ∂(Γ, Ω)/∂q_h, ∂(Γ, Ω)/∂q_{h+1}
-      link_jacobians(Dh, xp, rp.ds, JL, JR);
-      const Mat6 CL = rp.ds * c.asDiagonal() * JL, CR = rp.ds * c.asDiagonal() * JR;
-      Kd_[a].noalias() += JL.transpose() * CL;
-      Kd_[b].noalias() += JR.transpose() * CR;
-      Ko_[a].noalias() = JR.transpose() * CL;  // K[h+1][h]
-    }
-  }
+  for_each_link(rods_, ranges_, s,
+                [&](int a, int b, double ds, const Vec6& c, const Mat6& JL, const Mat6& JR) {
+                  const Mat6 CL = ds * c.asDiagonal() * JL, CR = ds * c.asDiagonal() * JR;
+                  Kd_[a].noalias() += JL.transpose() * CL;
+                  Kd_[b].noalias() += JR.transpose() * CR;
+                  Ko_[a].noalias() = JR.transpose() * CL;  // K[h+1][h]
+                });
 }
 
 Eigen::VectorXd ImplicitStepper::thermal_force(const rod::RodState& s, std::uint64_t step) const {
@@ -194,23 +206,15 @@ Eigen::VectorXd ImplicitStepper::thermal_force(const rod::RodState& s, std::uint
   const std::uint64_t seed = st_.params().fluid.seed;
   const std::uint32_t key0 = std::uint32_t(seed), key1 = std::uint32_t(seed >> 32);
   const std::uint32_t st0 = std::uint32_t(step), st1 = std::uint32_t(step >> 32);
-  for (std::size_t r = 0; r < rods_.size(); ++r) {
-    const rod::RodParams& rp = rods_[r];
-    const rod::RodRange& g = ranges_[r];
-    for (int h = 0; h < rod::half_points(g.n, g.closed); ++h) {
-      const int a = g.offset + h, b = g.offset + (h + 1) % g.n;
-      const Eigen::Matrix<double, 6, 1> c = moduli(rp, h);
-      Mat6 JL, JR;
-      link_jacobians(rod::half_point_triad(s.D[a], s.D[b]), (s.X[b] - s.X[a]) / rp.ds, rp.ds, JL,
-                     JR);
-      double z[6];  // counter word 1 = 2: apart from the stress (0) and the drift's pairs (1)
-      unit_variance6(philox4x32_10({std::uint32_t(a), 2u, st0, st1}, key0, key1), z);
-      Eigen::Matrix<double, 6, 1> y;
-      for (int i = 0; i < 6; ++i) y[i] = std::sqrt(kT_ * rp.ds * c[i]) * z[i];
-      f.segment<6>(6 * a) += JL.transpose() * y;
-      f.segment<6>(6 * b) += JR.transpose() * y;
-    }
-  }
+  for_each_link(rods_, ranges_, s,
+                [&](int a, int b, double ds, const Vec6& c, const Mat6& JL, const Mat6& JR) {
+                  double z[6];  // counter word 1 = 2: apart from the stress (0), the drift (1)
+                  unit_variance6(philox4x32_10({std::uint32_t(a), 2u, st0, st1}, key0, key1), z);
+                  Vec6 y;
+                  for (int i = 0; i < 6; ++i) y[i] = std::sqrt(kT_ * ds * c[i]) * z[i];
+                  f.segment<6>(6 * a) += JL.transpose() * y;
+                  f.segment<6>(6 * b) += JR.transpose() * y;
+                });
   return f;
 }
 
@@ -266,7 +270,6 @@ void ImplicitStepper::fd_stiffness(const rod::RodState& all, std::size_t rod_ind
     if (!closed && (j + o < 0 || j + o >= n)) return -1;
     return ((j + o) % n + n) % n;
   };
-  using Vec6 = Eigen::Matrix<double, 6, 1>;
   // Gauss–Newton: the stress resultants of half point h, σ_h = (D_hᵀF_h, D_hᵀN_h) = C (ε_h − ε₀),
   // and their derivatives S_L = ∂σ_h/∂q_h, S_R = ∂σ_h/∂q_{h+1} by the same differences
   using Mat6 = Eigen::Matrix<double, 6, 6>;

@@ -99,18 +99,7 @@ TEST(ImplicitThermal, OneStepCovarianceIsTheLinearModels) {
   const int n = s.size(), N = 6 * n;
   const double dt = 1e-9, kT = r.p.stepper.fluid.thermal_kT;
   // the model: M by columns (the stepper's own Stokes solve), M_loc = β D O D, K at s
-  Eigen::MatrixXd M(N, N);
-  std::vector<Vec3> F(n), T(n), U(n), W(n);
-  for (int c = 0; c < N; ++c) {
-    std::fill(F.begin(), F.end(), Vec3::Zero());
-    std::fill(T.begin(), T.end(), Vec3::Zero());
-    (c % 6 < 3 ? F : T)[c / 6][c % 3] = 1.0;
-    imp.mobility(s.X, F, T, U, W);
-    for (int k = 0; k < n; ++k) {
-      M.block<3, 1>(6 * k, c) = U[k];
-      M.block<3, 1>(6 * k + 3, c) = W[k];
-    }
-  }
+  Eigen::MatrixXd M = imp.mobility_matrix(s.X);
   M = 0.5 * (M + M.transpose()).eval();
   const GridSpec& g = r.p.stepper.grid;
   const std::vector<Vec3> X1{Vec3(0.31, 0.57, 0.73) * g.h()};
