@@ -17,6 +17,9 @@ using ::testing::HasSubstr;
 
 namespace {
 
+// the runs these tests kill mid-way run at a lower priority than the test that watches their rows
+constexpr int kKilledNice = 10;
+
 // 16³ grid, 100 points, 200 Å box (helpers.hpp), 600 steps of 0.1 ns. FFTW_MEASURE and two
 // threads, so that plans and OpenMP reductions are exercised; checkpoints every 50 steps, rows
 // every 20, frames every 40 (none of them divides the others).
@@ -72,7 +75,7 @@ fs::path Restart::root_;
 TEST_F(Restart, KilledTwiceAndResumedIsBitwiseIdentical) {
   const fs::path b = root_ / "B";
   // kill -9 after 9 rows (step ≥ 160: checkpoint 150 or later), resume, kill again after 22 rows
-  Child c = spawn(run_args("B"), root_ / "B1.log");
+  Child c = spawn(run_args("B"), root_ / "B1.log", 0, 0, kKilledNice);
   ASSERT_TRUE(wait_for_lines(c, b / "timeseries.csv", 1 + 9)) << read_file(root_ / "B1.log");
   ::kill(c.pid, SIGKILL);
   Exit e = wait_for(c);
@@ -80,7 +83,7 @@ TEST_F(Restart, KilledTwiceAndResumedIsBitwiseIdentical) {
   const std::int64_t ck1 = io::read_checkpoint(b / "checkpoint.bin").meta.step;
   EXPECT_EQ(ck1 % 50, 0);
 
-  c = spawn({"run", "--resume", b.string()}, root_ / "B2.log");
+  c = spawn({"run", "--resume", b.string()}, root_ / "B2.log", 0, 0, kKilledNice);
   ASSERT_TRUE(wait_for_lines(c, b / "timeseries.csv", 1 + 22)) << read_file(root_ / "B2.log");
   ::kill(c.pid, SIGKILL);
   e = wait_for(c);
@@ -99,7 +102,7 @@ TEST_F(Restart, KilledTwiceAndResumedIsBitwiseIdentical) {
 
 TEST_F(Restart, SigtermWritesACheckpointAndTheRunContinuesExactly) {
   const fs::path b = root_ / "T";
-  Child c = spawn(run_args("T"), root_ / "T1.log");
+  Child c = spawn(run_args("T"), root_ / "T1.log", 0, 0, kKilledNice);
   ASSERT_TRUE(wait_for_lines(c, b / "timeseries.csv", 1 + 12)) << read_file(root_ / "T1.log");
   ::kill(c.pid, SIGTERM);
   Exit e = wait_for(c);
