@@ -7,6 +7,10 @@
 // energies.csv, for probe_linear.py to set against the linear model (dump_linear's B) applied to
 // the same displacements.
 //   probe_steps CONFIG OUTDIR [key=value ...] [state=FILE] [dt_ns=DT] [noisy=N1] [det=N2] [samples=S]
+//               [relax=R] [fk=0] [gn=0] [second=1] [apply=FILE]
+// relax=R: R deterministic steps first, the relaxed start written to relaxed.csv; fk=0: no
+// thermal force (candidate A); gn=0: the full Hessian in the filter; second=1: the second step's
+// noise against the first's (second.bin); apply=FILE: energies of given displacements.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
