@@ -114,6 +114,29 @@ namespace {
 double now() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
+}  // namespace
+
+void ImplicitStepper::overlap_at(std::span<const Vec3> X) {
+  const double t1 = now();
+  // the taper along each rod (off by default), in points: the narrowest of the rods' (each
+  // rod's kernel reach along it, clamped to half the rod)
+  double window = 0.0;
+  if (p_.overlap_window > 0) {
+    window = HUGE_VAL;
+    for (const rod::RodRange& g : ranges_) {
+      const double reach = 4 * st_.params().kernel_width * st_.params().grid.h() / g.ds;
+      window = std::min(window, std::min(p_.overlap_window * reach, 0.5 * g.n));
+    }
+  }
+  Mov_ = kernel_overlap(X, st_.params().grid, st_.params().kernel_width, window, ranges_);
+  auto d = [&](Eigen::Index i) { return i % 6 < 3 ? ov_t_ : ov_r_; };
+  for (Eigen::Index c = 0; c < Mov_.outerSize(); ++c)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(Mov_, c); it; ++it)
+      it.valueRef() *= p_.mobility_scale * d(it.row()) * d(it.col());
+  timings_.overlap += now() - t1;
+}
+
+namespace {
 bool same_state(const rod::RodState& a, const rod::RodState& b) {
   return a.X.size() == b.X.size() && std::equal(a.X.begin(), a.X.end(), b.X.begin()) &&
          std::equal(a.D.begin(), a.D.end(), b.D.begin());
@@ -204,7 +227,9 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
 
   if (local || p_.krylov_max_iter > 0) {
     bool moved = false;
-    if (p_.refresh_displacement > 0 && have_K_ && X_K_.size() == s.X.size()) {
+    // (with noise the held K, M_loc are those of the previous step's midpoint, only the
+    // predictor's: no refresh by displacement)
+    if (p_.refresh_displacement > 0 && kT_ <= 0 && have_K_ && X_K_.size() == s.X.size()) {
       const double d2 = p_.refresh_displacement * p_.refresh_displacement;
       for (std::size_t k = 0; k < s.X.size() && !moved; ++k)
         moved = (s.X[k] - X_K_[k]).squaredNorm() > d2;
@@ -233,26 +258,7 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
       } else {
         K_ = stiffness(s);
       }
-      if (overlap && local) {
-        // M_loc = β D O D at qⁿ
-        const double t1 = now();
-        // the taper along each rod (off by default), in points: the narrowest of the rods'
-        // (each rod's kernel reach along it, clamped to half the rod)
-        double window = 0.0;
-        if (p_.overlap_window > 0) {
-          window = HUGE_VAL;
-          for (const rod::RodRange& g : ranges_) {
-            const double reach = 4 * st_.params().kernel_width * st_.params().grid.h() / g.ds;
-            window = std::min(window, std::min(p_.overlap_window * reach, 0.5 * g.n));
-          }
-        }
-        Mov_ = kernel_overlap(s.X, st_.params().grid, st_.params().kernel_width, window, ranges_);
-        auto d = [&](Eigen::Index i) { return i % 6 < 3 ? ov_t_ : ov_r_; };
-        for (Eigen::Index c = 0; c < Mov_.outerSize(); ++c)
-          for (Eigen::SparseMatrix<double>::InnerIterator it(Mov_, c); it; ++it)
-            it.valueRef() *= p_.mobility_scale * d(it.row()) * d(it.col());
-        timings_.overlap += now() - t1;
-      }
+      if (overlap && local) overlap_at(s.X);  // M_loc = β D O D at qⁿ
       have_K_ = true;
       timings_.stiffness += now() - t0;
       info.jacobian_refreshed = true;
@@ -346,15 +352,20 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
     // with thermal noise (docs/thermal.md, "The implicit step with noise"; a = 0: candidate D)
     //   u = A [J G 𝒮(F + (1 − a) f_K) + J G ξ + a M_loc f_K],  A = (I + Δt M_loc K)⁻¹,
     // G = (−μL_h)⁻¹P, ξ the random stress of the same solve, f_K ~ N(0, kT K_GN): the
-    // displacement's covariance Δt² A (2kT M/Δt + kT M K M) Aᵀ for a = 0
+    // displacement's covariance Δt² A (2kT M/Δt + kT M K M) Aᵀ for a = 0. The filter A (through
+    // M_loc and K) and, with the drift, J are taken at the step's midpoint
+    // q̃ = qⁿ ⊕ (Δt/2) u₀, u₀ a predictor with the filter held (docs/thermal.md "Why the
+    // implicit step with noise was hot": A(qⁿ) makes the noise multiplicative in the stiff
+    // strains and the stretch/shear energy runs away)
     const std::uint64_t step = st_.fluid().noise_step();
-    const VectorXd fK =
-        p_.thermal_force ? thermal_force(s, step) : VectorXd(VectorXd::Zero(6 * Eigen::Index(n)));
     const double a = p_.thermal_force_local;
     const std::size_t pts = drift_ ? 3 * std::size_t(n) : std::size_t(n);
     Xn_.resize(pts);
     Fn_.resize(pts);
     Tn_.assign(pts, Vec3::Zero());
+    const VectorXd fK =
+        p_.thermal_force ? thermal_force(s, step) : VectorXd(VectorXd::Zero(6 * Eigen::Index(n)));
+    // the rod's points and forces of the solve: F + (1 − a) f_K at Xⁿ
     for (int k = 0; k < n; ++k) {
       Xn_[k] = s.X[k];
       Fn_[k] = c0.F[k] + (1 - a) * fK.segment<3>(6 * k);
@@ -381,6 +392,7 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
     ib::PlaneCoupler& pc = st_.plane_coupler();
     fluid::FluidSolver& fl = st_.fluid();
     fl.set_dt(dt);  // the random stress's variance is 2kT/Δt
+    // the Stokes solve of the forces and the random stress, U, W interpolated at Xⁿ
     const double t0 = now();
     pc.prepare(Xn_, Fn_, Tn_);
     {
@@ -392,17 +404,39 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
     ++info.fluid_solves;
     VectorXd v;
     pack(U_, W_, v);
-    const VectorXd loc =
-        a > 0 ? VectorXd(a * (Mov_ * fK)) : VectorXd(VectorXd::Zero(6 * Eigen::Index(n)));
-    u = precondition(VectorXd(v + loc));
-    if (drift_) {
-      // (∂_X J) : G 𝒮 by the midpoint interpolation U, W = J(X̃) u, X̃ = Xⁿ + (Δt/2) u_X: the
-      // velocity the solve left on the grid, sampled plane by plane as Stepper::drift_step does
-      // (its mean over the noise is kT (∂_X J) : (A J G) — the Stokes-limit velocity covariance
-      // 2kT G/Δt on every mode — filtered like M F)
-      for (int k = 0; k < n; ++k) Xn_[k] = s.X[k] + (0.5 * dt) * u.segment<3>(6 * k);
+    auto local_share = [&]() {  // a M_loc f_K (M_loc held, then q̃'s)
+      return a > 0 ? VectorXd(a * (Mov_ * fK)) : VectorXd(VectorXd::Zero(6 * Eigen::Index(n)));
+    };
+    // the predictor, with the filter held (the previous step's midpoint one, or qⁿ's after a
+    // refresh): it only places the midpoint
+    u = precondition(VectorXd(v + local_share()));
+    // the midpoint q̃ and its filter: M_loc (the kernel overlap of neighbouring points, over
+    // its sub-kernel modes) and K (through X′ and the triads) depend on the stiff strains
+    // themselves; a covariance taken at the midpoint is the same for the step and its
+    // reverse, as for an additive noise
+    mid_ = s;
+    unpack(u, U_, W_);
+    rod::advance(mid_, U_, W_, 0.5 * dt);
+    {
       const double t1 = now();
-      pc.prepare(std::span<const Vec3>(Xn_.data(), std::size_t(n)), {}, {});
+      K_ = stiffness(mid_);
+      overlap_at(mid_.X);
+      X_K_ = mid_.X;
+      const double t2 = now();
+      timings_.stiffness += t2 - t1;
+      factorize(wdt);
+      timings_.factorize += now() - t2;
+      ++timings_.factorizations;
+    }
+    // (f_K stays at qⁿ: taken at q̃ too — a second Stokes solve — it measured no cooler,
+    // docs/thermal.md)
+    if (drift_) {
+      // (∂_X J) : G 𝒮 by the midpoint interpolation U, W = J(X̃) u, X̃ = Xⁿ + (Δt/2) u_X (the
+      // midpoint q̃'s positions): the velocity the solve left on the grid, sampled plane by
+      // plane as Stepper::drift_step does (its mean over the noise is kT (∂_X J) : (A J G) —
+      // the Stokes-limit velocity covariance 2kT G/Δt on every mode — filtered like M F)
+      const double t1 = now();
+      pc.prepare(mid_.X, {}, {});
       const int N = st_.params().grid.n;
       const std::size_t np = std::size_t(N) * std::size_t(N);
       const std::array<const double*, 3> ug{fl.velocity(0), fl.velocity(1), fl.velocity(2)};
@@ -412,8 +446,8 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
       pc.finish_interpolation(U_, W_);
       timings_.stokes += now() - t1;
       pack(U_, W_, v);
-      u = precondition(VectorXd(v + loc));
     }
+    u = precondition(VectorXd(v + local_share()));
   } else if (p_.velocity_form) {
     // (I + Δt M K) u = M F, δ = Δt u; the IMEX guess u₀ = (I + Δt M_loc K)⁻¹ M F
     const VectorXd mf = apply_mobility(b);

@@ -138,11 +138,15 @@ class ImplicitStepper {
   ///   u = (I + Δt M_loc K)⁻¹ [J(−μL_h)⁻¹P(𝒮(F + (1 − a) f_K) + ξ) + a M_loc f_K]
   /// with ξ the random stress of the same Stokes solve (FluidSolver::solve_stokes, thermal),
   /// f_K ~ N(0, kT K_GN) the thermal force of the Gauss–Newton stiffness (thermal_force) and
-  /// a = thermal_force_local; with the System's thermal_drift, the random finite difference of
-  /// the spreading joins the same solve and U, W are interpolated at the midpoint
-  /// X̃ = Xⁿ + (Δt/2) u_X (a second local solve). The draws are keyed by the fluid's seed and
-  /// noise_step() (set per step by the caller), so a step is a function of (qⁿ, Δt, seed,
-  /// step) alone.
+  /// a = thermal_force_local. The filter (I + Δt M_loc K)⁻¹ is taken at the step's midpoint
+  /// q̃ = qⁿ ⊕ (Δt/2) u₀, u₀ the same step with the filter held (the previous step's midpoint
+  /// one, or qⁿ's after a refresh): K, M_loc and their LU are made again at q̃ every step (the
+  /// refresh by displacement does not apply; docs/thermal.md "Why the implicit step with noise
+  /// was hot"). With the System's thermal_drift, the random finite difference of the spreading
+  /// joins the same solve and U, W are interpolated at q̃'s positions. The draws are keyed by
+  /// the fluid's seed and noise_step() (set per step by the caller), so a step is a function of
+  /// (qⁿ, Δt, seed, step) and of the filter held (refresh_jacobian() makes it qⁿ's: a resume
+  /// from a periodic checkpoint steps alike).
   /// One implicit step of size dt (s): rod from qⁿ to qⁿ⁺¹. Returns what it did. The forces at
   /// qⁿ⁺¹ are computed here (for energy_after) and kept for the next step, so a step costs one
   /// force evaluation and 1 + krylov_iterations Stokes solves. The potential energies at qⁿ are
@@ -212,6 +216,8 @@ class ImplicitStepper {
   std::vector<Eigen::Matrix<double, 6, 6>> sdiag_, slower_;  // its blocks (scratch)
   bool use_blocks_ = false, have_K_ = false;
   void gn_blocks(const rod::RodState& s);  // fills Kd_, Ko_
+  void overlap_at(std::span<const Vec3> X);  // Mov_ = M_loc = β D O D at X
+  rod::RodState mid_;                        // thermal: the midpoint q̃ of the step (scratch)
   // the finite-difference K of rod r (stiffness_fd or gauss_newton = false) into trip
   void fd_stiffness(const rod::RodState& s, std::size_t r,
                     std::vector<Eigen::Triplet<double>>& trip);
