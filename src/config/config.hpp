@@ -34,6 +34,7 @@ struct Config {
   double time_t_end_us = 0.5;  ///< time.t_end_us: simulated time, µs
   double time_stop_kinetic_kT =
       1e-12;                        ///< time.stop_kinetic_kT: stop when E_K below, kT (0: never)
+  double time_stop_power_kT_per_us = 0;  ///< time.stop_power_kT_per_us: stop when |Σ F·U| below
   bool time_stability_test = true;  ///< test a state before calling it an equilibrium
   double time_stability_amplitude_rad = 0.05;  ///< twist perturbation of the test, rad
   double time_stability_kick_A = 1.0;          ///< out-of-plane position kick of the test, Å

@@ -352,6 +352,7 @@ sim::SimParams to_params(const Config& c) {
   s.plan_measure = c.run_fftw_measure;
   p.t_end = c.time_t_end_us * us;
   p.stop_kinetic = c.time_stop_kinetic_kT * p.kT;
+  p.stop_power = c.time_stop_power_kT_per_us * p.kT / 1e-6;
   p.stability.enabled = c.time_stability_test;
   p.stability.amplitude = c.time_stability_amplitude_rad;
   p.stability.kick = c.time_stability_kick_A;

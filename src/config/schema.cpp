@@ -384,6 +384,10 @@ const std::vector<Key>& schema() {
            "simulated time, µs"),
       real("time.stop_kinetic_kT", &Config::time_stop_kinetic_kT, 0, false, 1e20,
            "stop when the fluid kinetic energy falls below this, kT (0: never)"),
+      real("time.stop_power_kT_per_us", &Config::time_stop_power_kT_per_us, 0, false, 1e20,
+           "stop when the power of the rods' loads, |Σ F·U + T·W| (the rate at which their "
+           "energy goes into the fluid), falls below this, kT/µs; either scheme, with the "
+           "stability test as the kinetic-energy rule (0: never; docs/config.md)"),
       boolean("time.stability_test", &Config::time_stability_test,
               "test a state the kinetic-energy rule calls an equilibrium by perturbing a copy "
               "(docs/config.md); false: stop at once"),
@@ -463,8 +467,8 @@ const std::vector<Key>& schema() {
       initial_shape_key(),
       boolean("rod.closed", &Config::rod_closed,
               "true: a closed ring; false: an open rod with two free ends, straight along x "
-              "unless rod.initial_shape gives its shape (needs rod.excess_link = 0 and "
-              "time.scheme = \"explicit\"; docs/model.md \"Open rods\")"),
+              "unless rod.initial_shape gives its shape (needs rod.excess_link = 0; "
+              "docs/model.md \"Open rods\")"),
       vec3_key("rod.rotation_deg", &Config::rod_rotation_deg, 360.0,
                "turn the initial circle or straight rod about its centre by these angles about "
                "the x, then y, then z axis, degrees (not with rod.initial_shape)"),

@@ -491,6 +491,12 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
   return info;
 }
 
+double ImplicitStepper::power() const {
+  // after a step prev_ holds the loads at its start (an undone step swapped them back)
+  return has_prev_ ? integrate::power(prev_.F, prev_.T, U_, W_)
+                   : std::numeric_limits<double>::quiet_NaN();
+}
+
 StepOutcome outcome(const ImplicitStepInfo& info) {
   StepOutcome o;
   o.max_displacement = info.max_displacement;

@@ -188,6 +188,9 @@ class ImplicitStepper {
   const StepEnergies& last_energies() const { return last_; }
   const std::vector<Vec3>& velocities() const { return U_; }          ///< [n] δX/Δt, Å s⁻¹
   const std::vector<Vec3>& angular_velocities() const { return W_; }  ///< [n] δθ/Δt, s⁻¹
+  /// Σ F·U + T·W of the latest step(): the loads at its start qⁿ and its velocities (Scheme::
+  /// power); NaN before a step
+  double power() const;
   System& system() { return st_; }
   int contacts() const { return contacts_; }
   const ImplicitTimings& timings() const {
@@ -283,6 +286,7 @@ class ImplicitIntegrator final : public Scheme {
   State state() const { return {ctl_.dt(), ctl_.accepted_in_a_row()}; }
   void restore(const State& st);
   void refresh() override { stepper_.refresh_jacobian(); }
+  double power() const override { return stepper_.power(); }
   ImplicitStepper& stepper() { return stepper_; }
   const ImplicitStepper& stepper() const { return stepper_; }
   const AdaptiveDt& controller() const { return ctl_; }

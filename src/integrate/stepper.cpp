@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <limits>
 #include <utility>
 
 #include "core/philox.hpp"
@@ -36,7 +37,12 @@ double Stepper::advance(rod::RodState& s, double /*max_dt*/) {
   return p_.fluid.dt;
 }
 
+double Stepper::power() const {
+  return stepped_ ? integrate::power(F_, T_, U_, W_) : std::numeric_limits<double>::quiet_NaN();
+}
+
 void Stepper::step(rod::RodState& s, StepPhaseTimes* phases) {
+  stepped_ = true;
   sys_.compute_forces(s, phases);
   PhaseClock clock(dist_ ? nullptr : phases);
   if (dist_) {

@@ -40,6 +40,7 @@ class Stepper final : public Scheme {
   /// Scheme: step(s); returns the fixed Δt (max_dt is not honoured: the explicit Δt is fixed).
   double advance(rod::RodState& s, double max_dt) override;
   bool adaptive() const override { return false; }
+  double power() const override;
 
   System& system() { return sys_; }
   const System& system() const { return sys_; }
@@ -61,6 +62,7 @@ class Stepper final : public Scheme {
   const std::vector<Vec3>& T_;
   // [n] velocities U (Å s⁻¹), angular velocities W (s⁻¹)
   std::vector<Vec3> U_, W_;
+  bool stepped_ = false;                      // a step() taken: U_, W_ are its velocities (power())
   std::vector<Vec3> Xa_, Fa_, Ta_, Ua_, Wa_;  // thermal_drift: the points with the RFD pairs
   void drift_step(rod::RodState& s, PhaseClock& clock);
   std::vector<double> rank_sum_;  // distributed: [6n] U then W, packed for sum_over_ranks

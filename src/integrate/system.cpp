@@ -199,4 +199,11 @@ void System::set_whole_velocity(std::array<const double*, 3> u) {
   for (int c = 0; c < 3; ++c) std::copy_n(u[c], n3, fluid_->velocity(c));
 }
 
+double power(std::span<const Vec3> F, std::span<const Vec3> T, std::span<const Vec3> U,
+             std::span<const Vec3> W) {
+  double p = 0;
+  for (std::size_t k = 0; k < F.size(); ++k) p += F[k].dot(U[k]) + T[k].dot(W[k]);
+  return p;
+}
+
 }  // namespace ibrod::integrate

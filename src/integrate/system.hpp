@@ -9,6 +9,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "core/grid.hpp"
@@ -205,6 +206,15 @@ class Scheme {
   /// The next step starts afresh from the state (a checkpoint written or read, a state set):
   /// what a scheme keeps between steps from the state (the implicit stiffness) is rebuilt.
   virtual void refresh() {}
+  /// The power of the rods' loads in the latest step, Σ_k F_k·U_k + T_k·W_k (g Å² s⁻³), with
+  /// the forces and torques the step moved the rods by and the velocities it moved them with:
+  /// the rate −dE_pot/dt at which the potential energy goes into the fluid (the dissipation
+  /// F·M F of the Stokes limit). NaN before this object's first step (time.stop_power_kT_per_us).
+  virtual double power() const = 0;
 };
+
+/// Σ_k F_k·U_k + T_k·W_k over the points (g Å² s⁻³ for g Å s⁻², g Å² s⁻², Å s⁻¹, s⁻¹).
+double power(std::span<const Vec3> F, std::span<const Vec3> T, std::span<const Vec3> U,
+             std::span<const Vec3> W);
 
 }  // namespace ibrod::integrate

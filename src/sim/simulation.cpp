@@ -61,6 +61,7 @@ SimParams checked(SimParams p) {
     // docs/thermal.md: with noise the fluid never comes to rest, so the kinetic-energy
     // equilibrium rule (and the stability test it triggers) is off; a run ends at t_end
     p.stop_kinetic = 0;
+    p.stop_power = 0;
     p.stability.enabled = false;
   }
   if (p.stepper.rods.empty() || p.shapes.size() != p.stepper.rods.size())
@@ -302,6 +303,9 @@ double Simulation::total_energy_kT() {
 
 StopReason Simulation::stop_reason(const Observables& o) const {
   if (step_ > 0 && o.E_kinetic_kT * p_.kT < p_.stop_kinetic) return StopReason::equilibrium;
+  // (NaN before this process's first step: a resumed run decides after a step of its own)
+  if (step_ > 0 && p_.stop_power > 0 && std::abs(scheme_->power()) < p_.stop_power)
+    return StopReason::equilibrium;
   if (at_end()) return StopReason::end_time;
   return StopReason::none;
 }

@@ -58,9 +58,12 @@ struct SimParams {
   /// dt_min ≤ 0 becomes 1e-3 dt, a max_displacement ≤ 0 becomes 0.2 min(1/κ, D))
   integrate::ImplicitParams implicit;
   integrate::AdaptiveDtParams adaptive;
-  double dt = 1e-10;         ///< time step Δt, s (implicit: the largest and the first)
-  double t_end = 1e-6;       ///< s
-  double stop_kinetic = 0;   ///< stop when E_K < this (g Å² s⁻²) at an output step; 0: never
+  double dt = 1e-10;        ///< time step Δt, s (implicit: the largest and the first)
+  double t_end = 1e-6;      ///< s
+  double stop_kinetic = 0;  ///< stop when E_K < this (g Å² s⁻²) at an output step; 0: never
+  /// stop when |the power of the rods' loads| (integrate::Scheme::power) < this (g Å² s⁻³) at an
+  /// output step; 0: never. Either rule calls the state an equilibrium (and so the stability test)
+  double stop_power = 0;
   StabilityProbe stability;  ///< tests a state the kinetic-energy rule calls an equilibrium
   OutputSchedule output;
   double kT = 414.2;                ///< g Å² s⁻²
@@ -229,8 +232,12 @@ class Simulation {
   /// E_total of observe() (the same terms, summed in the same order, so the same number) without
   /// the O(n²) diagnostics: cheap enough for every few steps.
   double total_energy_kT();
-  /// The stop rules, checked at output steps (o: the row of the current step): E_K below the
-  /// threshold after step 0 (equilibrium), else the end of the time (end_time), else none.
+  /// The power of the rods' loads in the latest step (integrate::Scheme::power), kT/µs; NaN
+  /// before this object's first step.
+  double power_kT_per_us() const { return scheme_->power() * 1e-6 / p_.kT; }
+  /// The stop rules, checked at output steps (o: the row of the current step): E_K below its
+  /// threshold, or the power of the loads below its (when set), after step 0 (equilibrium), else
+  /// the end of the time (end_time), else none.
   StopReason stop_reason(const Observables& o) const;
 
  private:
