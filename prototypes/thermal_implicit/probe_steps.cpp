@@ -9,7 +9,8 @@
 //   probe_steps CONFIG OUTDIR [key=value ...] [state=FILE] [dt_ns=DT] [noisy=N1] [det=N2] [samples=S]
 //               [relax=R] [fk=0] [gn=0] [second=1] [apply=FILE]
 // relax=R: R deterministic steps first, the relaxed start written to relaxed.csv; fk=0: no
-// thermal force (candidate A); gn=0: the full Hessian in the filter; second=1: the second step's
+// thermal force (candidate A); gn=0: the full Hessian in the filter (the stepper's default with
+// noise since the geometric-stiffness fix; gn=1, this probe's default, is K_GN as before); second=1: the second step's
 // noise against the first's (second.bin); apply=FILE: energies of given displacements.
 #include <algorithm>
 #include <cmath>
@@ -102,6 +103,7 @@ int main(int argc, char** argv) {
   integrate::ImplicitParams ip = p.implicit;
   ip.thermal_force = fk != 0;
   ip.gauss_newton = gn != 0;
+  ip.thermal_hessian = gn == 0;  // (the stepper's default is the full Hessian with noise)
   integrate::Stepper st(p.stepper);
   integrate::ImplicitStepper det_step(st.system(), ip);
   sim::SimParams q = pth;

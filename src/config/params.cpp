@@ -526,16 +526,16 @@ std::vector<std::string> check_warnings(const Config& c) {
                 " ns: the stiff stretch and shear modes come out hot by O(Δt) (measured +9 % at "
                 "0.37 of the limit, +3 % at 0.19; docs/thermal.md) (use time.dt_ns <= " +
                 fmt(std::floor(0.25 * limit * 1000) / 1000) + " ns)");
-  // docs/thermal.md, "Why the implicit step with noise was hot": with the filter at the
-  // midpoint the stretch/shear energy is within 10 % of equipartition up to 1.6× the explicit
-  // limit on the 100 bp ring, 16 % hot at 3.2×, running away at 6.5×; no Monte-Carlo check yet
+  // docs/thermal.md, "The geometric stiffness in the filter": with the full-Hessian filter at the
+  // midpoint the 100 bp ring is 9-14 % above the Monte-Carlo energies at 1 ns (3.2x the explicit
+  // limit, 10 us), 30-54 % at 2 ns; no Monte-Carlo check of the shapes yet
   if (c.solvent_thermal && c.time_scheme == "implicit")
     w.push_back(
         "solvent.thermal = true with time.scheme = \"implicit\" is measured only on the 100 bp "
-        "ring: its stretch/shear energy within 10 % of equipartition at time.dt_ns = 0.1-0.5, "
-        "16 % above at 1 and running away at 2 (docs/thermal.md, \"Why the implicit step with "
-        "noise was hot\"); the shapes are not checked against Monte Carlo (keep time.dt_ns "
-        "within ~1.5x the explicit limit, or use time.scheme = \"explicit\")");
+        "ring: its stretch/shear, bend and twist energies 9-14 % above their Monte-Carlo means at "
+        "time.dt_ns = 1 and 30-54 % at 2 (docs/thermal.md, \"The geometric stiffness in the "
+        "filter\"); the shapes are not checked against Monte Carlo (keep time.dt_ns within ~3x "
+        "the explicit limit, or use time.scheme = \"explicit\")");
   const double r0 = rod::circle_radius(c.rod_base_pairs, c.rod_rise_A);
   const double kappa = p.stepper.electro.law.kappa;
   if (c.electrostatics_enabled && kappa > 0) {

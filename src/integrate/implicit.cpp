@@ -59,6 +59,9 @@ ImplicitStepper::ImplicitStepper(System& system, const ImplicitParams& p)
         "overlap local mobility with mobility_scale > 0 (docs/thermal.md)");
   if (kT_ > 0 && !(p_.thermal_force_local >= 0 && p_.thermal_force_local <= 1))
     throw std::invalid_argument("ImplicitStepper: thermal_force_local not in [0, 1]");
+  // with noise the filter takes the full Hessian (the thermal stresses' geometric stiffness;
+  // docs/thermal.md "The geometric stiffness in the filter")
+  if (kT_ > 0 && p_.thermal_hessian) p_.gauss_newton = false;
   for (auto* v : {&U_, &W_}) v->assign(n_, Vec3::Zero());
   bcc_.resize(rods_.size());
 

@@ -91,6 +91,13 @@ struct ImplicitParams {
   /// thermal noise: add the thermal force f_K at all (false: the random stress alone, candidate
   /// A of docs/thermal.md)
   bool thermal_force = true;
+  /// thermal noise: the filter's K is the full Hessian −∂(F, T)/∂(X, θ) of the elastic loads
+  /// (central finite differences, as gauss_newton = false; the constructor sets gauss_newton
+  /// false) instead of the Gauss–Newton K_GN. The thermal stresses give a geometric stiffness
+  /// H − K_GN that reaches 10–30× K_GN in directions K_GN holds soft; left out of the filter it
+  /// is stepped explicitly and heats the ring from ~1 ns on the 100 bp ring (docs/thermal.md
+  /// "The geometric stiffness in the filter"). f_K keeps the covariance kT K_GN.
+  bool thermal_hessian = true;
   double fd_dx = 1e-4;      ///< finite-difference step of K in positions, Å
   double fd_dtheta = 1e-5;  ///< ... and in rotation vectors, rad
 };
@@ -138,7 +145,8 @@ class ImplicitStepper {
   ///   u = (I + Δt M_loc K)⁻¹ [J(−μL_h)⁻¹P(𝒮(F + (1 − a) f_K) + ξ) + a M_loc f_K]
   /// with ξ the random stress of the same Stokes solve (FluidSolver::solve_stokes, thermal),
   /// f_K ~ N(0, kT K_GN) the thermal force of the Gauss–Newton stiffness (thermal_force) and
-  /// a = thermal_force_local. The filter (I + Δt M_loc K)⁻¹ is taken at the step's midpoint
+  /// a = thermal_force_local; K in the filter is the full Hessian of the elastic loads
+  /// (thermal_hessian, the default) or K_GN. The filter (I + Δt M_loc K)⁻¹ is taken at the step's midpoint
   /// q̃ = qⁿ ⊕ (Δt/2) u₀, u₀ the same step with the filter held (the previous step's midpoint
   /// one, or qⁿ's after a refresh): K, M_loc and their LU are made again at q̃ every step (the
   /// refresh by displacement does not apply; docs/thermal.md "Why the implicit step with noise
