@@ -298,6 +298,7 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
     mobility(*at, aF, aT, aU, aW);
     timings_.stokes += now() - t0;
     ++info.fluid_solves;
+    ++timings_.stokes_solves;
     VectorXd u;
     pack(aU, aW, u);
     return u;
@@ -402,6 +403,7 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
     pc.finish_interpolation(U_, W_, std::size_t(n));
     timings_.stokes += now() - t0;
     ++info.fluid_solves;
+    ++timings_.stokes_solves;
     VectorXd v;
     pack(U_, W_, v);
     auto local_share = [&]() {  // a M_loc f_K (M_loc held, then q̃'s)

@@ -119,6 +119,7 @@ struct ImplicitTimings {
   double analyze = 0;       ///< the LU's pattern analysis (in factorize too)
   long factorizations = 0;  ///< of the local system (count)
   long moved_refreshes = 0;  ///< refreshes of K made early by refresh_displacement (count)
+  long stokes_solves = 0;    ///< Stokes solves of all trial steps (count)
 };
 
 class ImplicitStepper {
