@@ -79,11 +79,6 @@ void validate_one(const Config& c) {
     bad("grid.box_A", fmt(c.grid_box_A),
         "at most " + fmt(kMaxBoxPerRise) + " rod.rise_A = " + fmt(kMaxBoxPerRise * c.rod_rise_A) +
             " Å (positions of that size keep 6 digits of a segment in double precision)");
-  if (c.time_scheme == "implicit" && c.time_implicit_order == 2 &&
-      c.time_implicit_krylov_iterations > 0)
-    bad("time.implicit_krylov_iterations", std::to_string(c.time_implicit_krylov_iterations),
-        "0 with time.implicit_order = 2 (GMRES corrects the order-1 step only; set "
-        "time.implicit_order = 1)");
   if (c.time_scheme == "implicit" && c.time_implicit_local_mobility == "overlap" &&
       2 * (4 * c.grid_kernel_width + 2) > c.grid_n)
     bad("time.implicit_local_mobility", "\"overlap\"",

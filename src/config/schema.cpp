@@ -432,10 +432,12 @@ const std::vector<Key>& schema() {
               "implicit: steps between refreshes of the stiffness and its factorisation (> 1: "
               "faster; a run resumed after a signal is then not bitwise the same)"),
       integer("time.implicit_krylov_iterations", &Config::time_implicit_krylov_iterations, 0, 1000,
-              "implicit: GMRES iterations toward linearly implicit Euler (0: none, IMEX)"),
+              "implicit: GMRES iterations on the Stokes mobility, each one Stokes solve: order 1, "
+              "toward linearly implicit Euler; order 2, on each ROS2 stage, W = I + γΔt M K "
+              "(docs/large_dt.md §10) (0: none)"),
       real("time.implicit_krylov_tol", &Config::time_implicit_krylov_tol, 0, true, 1,
-           "implicit: relative residual at which GMRES stops (not reached: the step is retried "
-           "shorter)"),
+           "implicit: relative residual at which GMRES stops (order 1: not reached, the step is "
+           "retried shorter; order 2: the step stands, its error estimate judges it)"),
       integer("time.implicit_order", &Config::time_implicit_order, 1, 2,
               "implicit: 1 (the linearly implicit IMEX Euler step, one Stokes solve a step; the "
               "default) or 2 (two-stage Rosenbrock-W, ROS2: second order, an error estimate and "

@@ -1,5 +1,6 @@
 #include "driver/bench_schemes.hpp"
 
+#include <algorithm>
 #include <chrono>
 
 #include "sim/simulation.hpp"
@@ -55,6 +56,7 @@ SchemeBenchResult bench_schemes(const config::Config& c, int explicit_steps, dou
     r.ms_local_solve = t.local_solve * per;
     r.ms_stokes = t.stokes * per;
     r.factorizations = t.factorizations;
+    r.stokes_solves = t.stokes_solves;
   }
   return r;
 }
@@ -70,9 +72,10 @@ void print_bench_schemes(const SchemeBenchResult& r, std::FILE* out) {
                r.implicit_rejections, r.implicit_ms_per_step, r.ratio());
   std::fprintf(out,
                "implicit, ms per step: forces %.2f, stiffness %.2f (M_loc %.2f), factorisation "
-               "%.2f (%ld of them), local solves %.2f, Stokes solves %.2f\n",
+               "%.2f (%ld of them), local solves %.2f, Stokes solves %.2f (%.2f a step)\n",
                r.ms_forces, r.ms_stiffness, r.ms_overlap, r.ms_factorize, r.factorizations,
-               r.ms_local_solve, r.ms_stokes);
+               r.ms_local_solve, r.ms_stokes,
+               double(r.stokes_solves) / double(std::max(r.implicit_steps, 1L)));
   std::fprintf(out, "us_per_hour_explicit=%.4g us_per_hour_implicit=%.4g\n", r.us_per_hour_explicit,
                r.us_per_hour_implicit);
 }

@@ -20,6 +20,7 @@ struct SchemeBenchResult {
   /// where the implicit step's time went, ms per accepted step (trials included): forces, K and
   /// M_loc (overlap: of which M_loc), the local factorisation, local solves, Stokes solves
   long factorizations = 0;  ///< of the implicit step's local system
+  long stokes_solves = 0;   ///< of the implicit steps, rejected trials included
   double ms_forces = 0, ms_stiffness = 0, ms_overlap = 0, ms_factorize = 0, ms_local_solve = 0,
          ms_stokes = 0;
   double ratio() const { return us_per_hour_implicit / us_per_hour_explicit; }

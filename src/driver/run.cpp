@@ -246,6 +246,7 @@ void Run::State::finish(const sim::Observables& o, const std::string& stop_reaso
   if (const integrate::ImplicitIntegrator* imp = sim->implicit()) {
     r.implicit_factorizations = imp->stepper().timings().factorizations;
     r.implicit_early_refreshes = imp->stepper().timings().moved_refreshes;
+    r.implicit_stokes_solves = imp->stepper().timings().stokes_solves;
   }
   r.link_drift = o.link - r.initial.link;
   r.max_link_drift = meta.max_link_drift;

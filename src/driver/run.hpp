@@ -65,6 +65,7 @@ struct RunResult {
   /// early by time.implicit_refresh_displacement_A (−1: the explicit scheme)
   long implicit_factorizations = -1;
   long implicit_early_refreshes = -1;
+  long implicit_stokes_solves = -1;
 };
 
 /// |Lk − Lk(0)| beyond which a run warns (once) of a likely self-passage.

@@ -86,6 +86,7 @@ std::string summary_json(const config::Config& c, bool closed, const RunResult& 
   if (r.implicit_factorizations >= 0) {
     j["implicit_factorizations"] = r.implicit_factorizations;
     j["implicit_early_refreshes"] = r.implicit_early_refreshes;
+    j["implicit_stokes_solves"] = r.implicit_stokes_solves;
   }
   j["total_wall_time_s"] = meta.wall_s;
   j["threads"] = meta.threads;

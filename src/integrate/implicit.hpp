@@ -39,8 +39,13 @@ namespace ibrod::integrate {
 
 struct ImplicitParams {
   double mobility_scale = 8.0;  ///< β: M_loc = β × the kernel's self mobility (≥ 0; 0: explicit)
-  int krylov_max_iter = 0;      ///< GMRES iterations after the IMEX guess (0: scheme (1))
-  double krylov_tol = 1e-2;     ///< relative residual of (1) at which GMRES stops
+  /// GMRES iterations after the local solve's guess, each one Stokes solve (0: none). Order 1:
+  /// toward the linearly implicit Euler step (I + Δt M K) u = M F. Order 2: on each ROS2 stage,
+  /// whose W is then I + γΔt M K with the Stokes mobility M at qⁿ (docs/large_dt.md §10)
+  int krylov_max_iter = 0;
+  /// relative residual at which GMRES stops; order 1: a step that does not reach it is
+  /// rejected (converged = false); order 2: it stands, judged by its error estimate
+  double krylov_tol = 1e-2;
   /// trial steps between refreshes of K and of its factorisation (≥ 1; K at qⁿ when refreshed,
   /// and whenever Δt changes). 1: K is a function of the state alone, so a run resumed from any
   /// checkpoint (a signal's too) is bitwise the same. > 1 saves ~1.4 ms per step at the 64³
@@ -70,6 +75,10 @@ struct ImplicitParams {
   /// second order for any approximation of the Jacobian (a W-method), two Stokes solves and two
   /// force evaluations per step, with the embedded first-order qⁿ + Δt k₁ for the error
   /// estimate Δt ½ (k₁ + k₂) (docs/large_dt.md "Error control and order"). Velocity form only.
+  /// With krylov_max_iter = m > 0 each stage is solved on W = I + γΔt M K instead (M the
+  /// Stokes mobility at qⁿ, GMRES right-preconditioned by W_loc: 2m + 4 Stokes solves a step;
+  /// converged, ROS2 with the exact M in its Jacobian: L-stable, its stability function
+  /// (1 + (1 − 2γ) z)/(1 − γz)²; docs/large_dt.md §10).
   int order = 1;
   /// M_loc: β diag(m_t I, m_r I), the kernel's self mobility on the diagonal (`self`), or
   /// β D O D, the kernel overlap O = 𝒥𝒮 scaled to the same self blocks
@@ -104,10 +113,13 @@ struct ImplicitParams {
 
 /// What one implicit step did (for the adaptive controller and the logs).
 struct ImplicitStepInfo {
-  int krylov_iterations = 0;    ///< GMRES iterations (0 for the IMEX scheme)
-  int fluid_solves = 0;         ///< Stokes solves this step (1 + iterations)
-  bool converged = true;        ///< residual ≤ krylov_tol (always true with krylov_max_iter = 0)
-  double residual = 0;          ///< relative residual of (1) at the end (−1: not computed)
+  int krylov_iterations = 0;  ///< GMRES iterations (0 for the IMEX scheme; order 2: both stages)
+  /// Stokes solves this step (order 1: 1, with GMRES 2 + iterations; order 2: 2, with GMRES
+  /// 4 + iterations)
+  int fluid_solves = 0;
+  /// order 1: residual ≤ krylov_tol (always true with krylov_max_iter = 0); order 2: true
+  bool converged = true;
+  double residual = 0;  ///< relative residual of (1) at the end (order 2: the larger stage's)
   double max_displacement = 0;  ///< max_k |δX_k|, Å
   double max_rotation = 0;      ///< max_k |δθ_k|, rad
   double energy_before = 0;     ///< potential energy (elastic + electrostatic + steric) at qⁿ,
@@ -126,6 +138,7 @@ struct ImplicitTimings {
   double analyze = 0;       ///< the LU's pattern analysis (in factorize too)
   long factorizations = 0;  ///< of the local system (count)
   long moved_refreshes = 0;  ///< refreshes of K made early by refresh_displacement (count)
+  long stokes_solves = 0;    ///< Stokes solves of all trial steps (count)
 };
 
 class ImplicitStepper {
