@@ -6,12 +6,14 @@
 // ([6n] × S (noisy + det + 1), column-major) and its elastic energies relative to the start in
 // energies.csv, for probe_linear.py to set against the linear model (dump_linear's B) applied to
 // the same displacements.
-//   probe_steps CONFIG OUTDIR [key=value ...] [state=FILE] [dt_ns=DT] [noisy=N1] [det=N2] [samples=S]
+//   probe_steps CONFIG OUTDIR [key=value ...] [state=FILE] [dt_ns=DT] [noisy=N1] [det=N2]
+//   [samples=S]
 //               [relax=R] [fk=0] [gn=0] [second=1] [apply=FILE]
 // relax=R: R deterministic steps first, the relaxed start written to relaxed.csv; fk=0: no
 // thermal force (candidate A); gn=0: the full Hessian in the filter (the stepper's default with
-// noise since the geometric-stiffness fix; gn=1, this probe's default, is K_GN as before); second=1: the second step's
-// noise against the first's (second.bin); apply=FILE: energies of given displacements.
+// noise since the geometric-stiffness fix; gn=1, this probe's default, is K_GN as before);
+// second=1: the second step's noise against the first's (second.bin); apply=FILE: energies of given
+// displacements.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -50,9 +52,9 @@ int main(int argc, char** argv) {
                   // O(Δs²)); the relaxed state in relaxed.csv, for dump_linear state=…
   std::string apply_file;  // apply=FILE: displacement columns ([6n] × m doubles) applied to the
                            // start by rod::advance: their elastic energies in applied.csv
-  int fk = 1, gn = 1;  // fk=0: no thermal force f_K (candidate A); gn=0: the full Hessian in W
-  bool second = false;  // second=1: per sample q1 = noisy(q0; a), q2d = det(q1), q2n = noisy(q1; b),
-                        // q1b = noisy(q0; b): traj columns (q1, q2d, q2n, q1b) − q0
+  int fk = 1, gn = 1;      // fk=0: no thermal force f_K (candidate A); gn=0: the full Hessian in W
+  bool second = false;     // second=1: per sample q1 = noisy(q0; a), q2d = det(q1), q2n = noisy(q1;
+                        // b), q1b = noisy(q0; b): traj columns (q1, q2d, q2n, q1b) − q0
   for (int i = 3; i < argc; ++i) {
     const std::string a = argv[i];
     if (a.rfind("state=", 0) == 0)
@@ -150,7 +152,8 @@ int main(int argc, char** argv) {
       rod::advance(s, dX, dT, 1.0);
       const rod::ElasticEnergy e = rod::elastic_energy(rp, s);
       a << c << "," << (e.stretch - e0.stretch) / (1.5 * n * kT) << ","
-        << (e.bend - e0.bend) / (n * kT) << "," << (e.twist - e0.twist) / (0.5 * n * kT) << std::endl;
+        << (e.bend - e0.bend) / (n * kT) << "," << (e.twist - e0.twist) / (0.5 * n * kT)
+        << std::endl;
     }
     std::printf("%zu displacements applied: %s/applied.csv\n", m, out.c_str());
     return 0;
@@ -207,7 +210,8 @@ int main(int argc, char** argv) {
     }
   }
   std::ofstream o(out + "/traj.bin", std::ios::binary);
-  o.write(reinterpret_cast<const char*>(traj.data()), std::streamsize(sizeof(double) * traj.size()));
+  o.write(reinterpret_cast<const char*>(traj.data()),
+          std::streamsize(sizeof(double) * traj.size()));
   std::printf("%d samples of %d noisy + %d deterministic steps at %g ns in %s\n", samples, noisy,
               det, dt_ns, out.c_str());
   return 0;

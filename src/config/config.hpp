@@ -33,9 +33,9 @@ struct Config {
   double time_dt_ns = 0.1;     ///< time.dt_ns: Δt, ns
   double time_t_end_us = 0.5;  ///< time.t_end_us: simulated time, µs
   double time_stop_kinetic_kT =
-      1e-12;                        ///< time.stop_kinetic_kT: stop when E_K below, kT (0: never)
+      1e-12;  ///< time.stop_kinetic_kT: stop when E_K below, kT (0: never)
   double time_stop_power_kT_per_us = 0;  ///< time.stop_power_kT_per_us: stop when |Σ F·U| below
-  bool time_stability_test = true;  ///< test a state before calling it an equilibrium
+  bool time_stability_test = true;       ///< test a state before calling it an equilibrium
   double time_stability_amplitude_rad = 0.05;  ///< twist perturbation of the test, rad
   double time_stability_kick_A = 1.0;          ///< out-of-plane position kick of the test, Å
   double time_stability_probe_us = 2.0;        ///< how long both copies are integrated, µs
@@ -51,11 +51,12 @@ struct Config {
   std::string time_implicit_local_mobility = "self";
   double time_implicit_overlap_scale = 1;        ///< implicit: β of the overlap M_loc
   int time_implicit_overlap_refresh_every = 50;  ///< implicit, overlap: steps between its LUs
-  double time_implicit_refresh_displacement_A = 1;  ///< implicit: refresh W when a point moved this far, Å (0: off)
-  int time_implicit_jacobian_every = 1;          ///< implicit: steps between stiffness refreshes
-  int time_implicit_krylov_iterations = 0;       ///< implicit: GMRES iterations (0: IMEX)
-  double time_implicit_krylov_tol = 1e-2;        ///< implicit: GMRES relative residual
-  int time_implicit_order = 1;                   ///< implicit: 1 (IMEX Euler) or 2 (ROS2), issue 24
+  double time_implicit_refresh_displacement_A =
+      1;  ///< implicit: refresh W when a point moved this far, Å (0: off)
+  int time_implicit_jacobian_every = 1;     ///< implicit: steps between stiffness refreshes
+  int time_implicit_krylov_iterations = 0;  ///< implicit: GMRES iterations (0: IMEX)
+  double time_implicit_krylov_tol = 1e-2;   ///< implicit: GMRES relative residual
+  int time_implicit_order = 1;              ///< implicit: 1 (IMEX Euler) or 2 (ROS2), issue 24
   double time_error_tolerance_A = 0.1;  ///< implicit, order 2: local error per step, Å (0: off)
   // [rod]
   int rod_base_pairs = 600;                         ///< rod.base_pairs: rod points n

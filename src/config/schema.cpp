@@ -423,8 +423,8 @@ const std::vector<Key>& schema() {
               "implicit, time.implicit_local_mobility = \"overlap\": steps between refreshes of "
               "M_loc, the stiffness and their LU (which costs ~10 Stokes solves at the "
               "reference; > 1: a run resumed after a signal is not bitwise the same)"),
-      real("time.implicit_refresh_displacement_A", &Config::time_implicit_refresh_displacement_A,
-           0, false, 1e4,
+      real("time.implicit_refresh_displacement_A", &Config::time_implicit_refresh_displacement_A, 0,
+           false, 1e4,
            "implicit: also refresh the stiffness, M_loc and their factorisation before their "
            "count of steps when a rod point has moved farther than this since the last refresh, "
            "Å (0: off; docs/large_dt.md §8)"),

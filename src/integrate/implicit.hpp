@@ -134,9 +134,9 @@ struct ImplicitStepInfo {
 /// Wall time spent in the parts of ImplicitStepper::step, accumulated, s.
 struct ImplicitTimings {
   double forces = 0, stiffness = 0, factorize = 0, local_solve = 0, stokes = 0;
-  double overlap = 0;       ///< building M_loc = β D O D (in stiffness too)
-  double analyze = 0;       ///< the LU's pattern analysis (in factorize too)
-  long factorizations = 0;  ///< of the local system (count)
+  double overlap = 0;        ///< building M_loc = β D O D (in stiffness too)
+  double analyze = 0;        ///< the LU's pattern analysis (in factorize too)
+  long factorizations = 0;   ///< of the local system (count)
   long moved_refreshes = 0;  ///< refreshes of K made early by refresh_displacement (count)
   long stokes_solves = 0;    ///< Stokes solves of all trial steps (count)
 };
@@ -159,10 +159,10 @@ class ImplicitStepper {
   /// with ξ the random stress of the same Stokes solve (FluidSolver::solve_stokes, thermal),
   /// f_K ~ N(0, kT K_GN) the thermal force of the Gauss–Newton stiffness (thermal_force) and
   /// a = thermal_force_local; K in the filter is the full Hessian of the elastic loads
-  /// (thermal_hessian, the default) or K_GN. The filter (I + Δt M_loc K)⁻¹ is taken at the step's midpoint
-  /// q̃ = qⁿ ⊕ (Δt/2) u₀, u₀ the same step with the filter held (the previous step's midpoint
-  /// one, or qⁿ's after a refresh): K, M_loc and their LU are made again at q̃ every step (the
-  /// refresh by displacement does not apply; docs/thermal.md "Why the implicit step with noise
+  /// (thermal_hessian, the default) or K_GN. The filter (I + Δt M_loc K)⁻¹ is taken at the step's
+  /// midpoint q̃ = qⁿ ⊕ (Δt/2) u₀, u₀ the same step with the filter held (the previous step's
+  /// midpoint one, or qⁿ's after a refresh): K, M_loc and their LU are made again at q̃ every step
+  /// (the refresh by displacement does not apply; docs/thermal.md "Why the implicit step with noise
   /// was hot"). With the System's thermal_drift, the random finite difference of the spreading
   /// joins the same solve and U, W are interpolated at q̃'s positions. The draws are keyed by
   /// the fluid's seed and noise_step() (set per step by the caller), so a step is a function of
@@ -239,7 +239,7 @@ class ImplicitStepper {
   std::vector<int> lu_outer_, lu_inner_;  // the pattern lu_ analysed (overlap)
   std::vector<Eigen::Matrix<double, 6, 6>> sdiag_, slower_;  // its blocks (scratch)
   bool use_blocks_ = false, have_K_ = false;
-  void gn_blocks(const rod::RodState& s);  // fills Kd_, Ko_
+  void gn_blocks(const rod::RodState& s);    // fills Kd_, Ko_
   void overlap_at(std::span<const Vec3> X);  // Mov_ = M_loc = β D O D at X
   rod::RodState mid_;                        // thermal: the midpoint q̃ of the step (scratch)
   // the finite-difference K of rod r (stiffness_fd or gauss_newton = false) into trip

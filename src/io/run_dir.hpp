@@ -64,10 +64,9 @@ class RunDir {
   /// run, with the frames of vtk/ that is_frame_file names; nothing else: a file of the user's
   /// in the directory or in vtk/ is kept).
   std::vector<std::filesystem::path> run_files() const {
-    return {config(),     timeseries(), root_ / kTrajectory, root_ / kLegacyTrajectory,
-            root_ / "rod.pvd", root_ / "fluid.pvd",
-            checkpoint(), wisdom(),     final_state(), summary(),         velocity(),
-            rods()};
+    return {config(),          timeseries(),        root_ / kTrajectory, root_ / kLegacyTrajectory,
+            root_ / "rod.pvd", root_ / "fluid.pvd", checkpoint(),        wisdom(),
+            final_state(),     summary(),           velocity(),          rods()};
   }
   /// Whether `name` (a file name in vtk/) is a frame a run writes: rod_<step>.vtp or
   /// fluid_<step>.vti (or such a file's ".tmp" of a write cut off).

@@ -79,9 +79,8 @@ struct Style {
 /// so that all its pictures share one scale and centre). X.size() ≥ 2, d1.size() = X.size() and
 /// the rods laid end to end over X, else std::invalid_argument.
 Image render_rods(std::span<const Vec3> X, std::span<const Vec3> d1,
-                  std::span<const rod::RodRange> rods, double diameter, const View& view,
-                  int width, int height, const Style& style = {},
-                  std::span<const Vec3> frame = {});
+                  std::span<const rod::RodRange> rods, double diameter, const View& view, int width,
+                  int height, const Style& style = {}, std::span<const Vec3> frame = {});
 /// render_rods of one closed ring, the whole of X.
 Image render_rod(std::span<const Vec3> X, std::span<const Vec3> d1, double diameter,
                  const View& view, int width, int height, const Style& style = {},

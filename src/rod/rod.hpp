@@ -35,9 +35,7 @@ struct RodParams {
 inline int half_points(int n, bool closed) { return closed ? n : (n > 0 ? n - 1 : 0); }
 /// The point before k along a rod of n points (closed: n − 1 before 0; open: the first point is
 /// its own, so that a central difference becomes one-sided at a free end).
-inline int point_before(int k, int n, bool closed) {
-  return k > 0 ? k - 1 : closed ? n - 1 : 0;
-}
+inline int point_before(int k, int n, bool closed) { return k > 0 ? k - 1 : closed ? n - 1 : 0; }
 /// The point after k (closed: 0 after n − 1; open: the last point is its own).
 inline int point_after(int k, int n, bool closed) { return k + 1 < n ? k + 1 : closed ? 0 : n - 1; }
 

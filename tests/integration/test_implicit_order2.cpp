@@ -186,8 +186,8 @@ TEST(ImplicitOrder2, TrueMobilityStagesSolveTheRosenbrockStagesOfTheStokesMobili
   double d0 = 0;
   for (int k = 0; k < n; ++k)
     d0 = std::max(d0, (loc.segment<3>(6 * k) - u.segment<3>(6 * k)).norm());
-  std::printf("max |u| %.4g, |u - dense| GMRES %.3g, W_loc %.3g A/s (%d iterations)\n", ref, d,
-              d0, info.krylov_iterations);
+  std::printf("max |u| %.4g, |u - dense| GMRES %.3g, W_loc %.3g A/s (%d iterations)\n", ref, d, d0,
+              info.krylov_iterations);
   EXPECT_LT(d, 1e-6 * ref);
   EXPECT_GT(d0, 1e-2 * ref);
 }

@@ -119,8 +119,8 @@ TEST(MpiRun, TwoRanksShareTheFluidGridAndAgreeWithOneProcess) {
   EXPECT_EQ(log.find("ibrod: stopped (end_time)"), log.rfind("ibrod: stopped (end_time)")) << log;
   expect_same_trajectory(d / "one", d / "two");
   // the same outputs as a one-process run (rank 0 wrote them)
-  for (const char* f :
-       {"config.toml", "summary.json", "trajectory.h5md", "checkpoint.bin", "fftw.wisdom", "rod.pvd"})
+  for (const char* f : {"config.toml", "summary.json", "trajectory.h5md", "checkpoint.bin",
+                        "fftw.wisdom", "rod.pvd"})
     EXPECT_TRUE(fs::exists(d / "two" / f)) << f;
   fs::remove_all(d);
 }

@@ -79,9 +79,9 @@ TEST(SchemeKeys, TheOverlapLocalMobilityAndItsScaleReachTheParameters) {
     EXPECT_THAT(e.what(), HasSubstr("-1"));
   }
   EXPECT_THAT(config::to_toml(c), HasSubstr("implicit_local_mobility = 'overlap'"));
-  for (const char* k : {"time.implicit_local_mobility", "time.implicit_overlap_scale",
-                        "time.implicit_overlap_refresh_every",
-                        "time.implicit_refresh_displacement_A"})
+  for (const char* k :
+       {"time.implicit_local_mobility", "time.implicit_overlap_scale",
+        "time.implicit_overlap_refresh_every", "time.implicit_refresh_displacement_A"})
     EXPECT_THAT(config::describe(c), HasSubstr(k));
   try {
     config::apply_override(c, "time.implicit_local_mobility=\"banded\"");
