@@ -318,6 +318,19 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
     return (x.array() * y.array() * w2.array()).sum();
   };
   const bool krylov = p_.krylov_max_iter > 0;
+  // GMRES's products leave on the grid the velocity of a Krylov direction, not of the loads: the
+  // field of the last solve of the loads (M F) is kept across them, so that E_K (and E_total,
+  // the .vti, the stop rules) stay the fluid's
+  auto keep_field = [&] {
+    const fluid::FluidSolver& f = st_.fluid();
+    const std::size_t n3 = st_.params().grid.size();
+    kept_u_.resize(3 * n3);
+    for (int c = 0; c < 3; ++c) std::copy_n(f.velocity(c), n3, kept_u_.data() + c * n3);
+  };
+  auto restore_field = [&] {
+    const std::size_t n3 = st_.params().grid.size();
+    st_.set_whole_velocity({kept_u_.data(), kept_u_.data() + n3, kept_u_.data() + 2 * n3});
+  };
   VectorXd u;
   if (p_.order == 2) {
     // ROS2: W k₁ = M F(qⁿ); W k₂ = M F(qⁿ + Δt k₁) − 2 k₁; u = 3/2 k₁ + 1/2 k₂. W is
@@ -362,7 +375,9 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
       at = &stage_.X;
       const VectorXd f2 = apply_mobility(b2);
       at = &s.X;
+      if (krylov) keep_field();
       const VectorXd k2 = stage_solve(VectorXd(f2 - 2.0 * k1));
+      if (krylov) restore_field();
       u = 1.5 * k1 + 0.5 * k2;
       // the embedded first-order solution qⁿ + Δt k₁ is Δt ½ (k₁ + k₂) away
       for (int k = 0; k < n; ++k) {
@@ -478,9 +493,11 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
     u = precondition(mf);
     if (krylov) {
       auto apply = [&](const VectorXd& x) -> VectorXd { return x + dt * apply_mobility(K_ * x); };
+      keep_field();
       info.krylov_iterations =
           gmres(apply, precondition, mf, u, p_.krylov_max_iter, p_.krylov_tol, dot, info.residual);
       info.converged = info.residual <= p_.krylov_tol;
+      restore_field();
     }
   } else {
     // (I + Δt K M) g = F, δ = Δt M g; the IMEX guess g₀ = (I + Δt K M_loc)⁻¹ F

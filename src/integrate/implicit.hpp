@@ -255,6 +255,7 @@ class ImplicitStepper {
   StepEnergies last_;
   ImplicitTimings timings_;
   rod::RodWork work_;                            // one rod's (finite-difference K)
+  std::vector<double> kept_u_;  // GMRES: the fluid velocity of the last solve of the loads
   std::vector<Vec3> U_, W_, Fa_, Ta_, Fb_, Tb_;  // U_, W_: all points; the others one rod's
   rod::RodState pert_, stage_;
   double kT_ = 0;                   // thermal noise: kT (0: none)
