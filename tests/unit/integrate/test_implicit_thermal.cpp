@@ -152,6 +152,23 @@ TEST(ImplicitThermal, OneStepCovarianceIsTheLinearModels) {
   EXPECT_GT(qd / qa, 1.3);
 }
 
+// <E_stretch + shear> over steps skip … steps − 1 of the ring's implicit thermal run at dt, over
+// its equipartition 3/2 n kT (three strains per link); HUGE_VAL if a step is not finite.
+double stretch_over_equipartition(const ImplicitParams& ip, double dt, int steps, int skip) {
+  ThermalRing r;
+  ImplicitStepper imp(*r.st, ip);
+  rod::RodState s = r.rod;
+  const int n = s.size();
+  const double kT = r.p.stepper.fluid.thermal_kT;
+  double sum = 0;
+  for (int i = 0; i < steps; ++i) {
+    r.st->set_noise_step(std::uint64_t(i));
+    if (!imp.step(s, dt).finite) return HUGE_VAL;  // (a runaway)
+    if (i >= skip) sum += imp.last_energies().elastic.stretch;
+  }
+  return sum / (steps - skip) / (1.5 * n * kT);
+}
+
 // A short equilibrium run (issue 28, docs/thermal.md "Why the implicit step with noise was
 // hot"): the 60-point ring from its strained state, Δt = 0.25 ns (0.8× the explicit limit),
 // 500 steps; the stretch/shear energy, averaged over steps 150–500, against equipartition
@@ -159,21 +176,11 @@ TEST(ImplicitThermal, OneStepCovarianceIsTheLinearModels) {
 // (the noise multiplicative in the strains) it ran away: 7.87; with A at the step's midpoint:
 // 0.94. ~5 s of CPU.
 TEST(ImplicitThermal, ShortRunSamplesTheStretchShearEnergyAtEquipartition) {
-  ThermalRing r;
-  ImplicitParams ip = r.ip;
+  ImplicitParams ip = ThermalRing().ip;
   ip.jacobian_every = 50;  // the default (time.implicit_overlap_refresh_every)
-  ImplicitStepper imp(*r.st, ip);
-  rod::RodState s = r.rod;
-  const int n = s.size(), steps = 500, skip = 150;
-  const double dt = 0.25e-9, kT = r.p.stepper.fluid.thermal_kT;
-  double sum = 0;
-  for (int i = 0; i < steps; ++i) {
-    r.st->set_noise_step(std::uint64_t(i));
-    const ImplicitStepInfo info = imp.step(s, dt);
-    ASSERT_TRUE(info.finite) << "step " << i;
-    if (i >= skip) sum += imp.last_energies().elastic.stretch;
-  }
-  const double ratio = sum / (steps - skip) / (1.5 * n * kT);
+  const int steps = 500, skip = 150;
+  const double ratio = stretch_over_equipartition(ip, 0.25e-9, steps, skip);
+  ASSERT_TRUE(std::isfinite(ratio));
   std::printf("  <E_stretch>/equipartition over steps %d-%d at 0.25 ns: %.3f\n", skip, steps,
               ratio);
   EXPECT_NEAR(ratio, 1.0, 0.2);
@@ -185,21 +192,9 @@ TEST(ImplicitThermal, ShortRunSamplesTheStretchShearEnergyAtEquipartition) {
 // the filter"). The same 60-point ring, seed and steps with either filter.
 TEST(ImplicitThermal, AtOneNanosecondTheHessianFilterKeepsTheStretchShearEnergyAtEquipartition) {
   auto run = [](bool hessian) {
-    ThermalRing r;
-    ImplicitParams ip = r.ip;
+    ImplicitParams ip = ThermalRing().ip;
     ip.thermal_hessian = hessian;
-    ImplicitStepper imp(*r.st, ip);
-    rod::RodState s = r.rod;
-    const int n = s.size(), steps = 300, skip = 100;
-    const double dt = 1e-9, kT = r.p.stepper.fluid.thermal_kT;
-    double sum = 0;
-    for (int i = 0; i < steps; ++i) {
-      r.st->set_noise_step(std::uint64_t(i));
-      const ImplicitStepInfo info = imp.step(s, dt);
-      if (!info.finite) return HUGE_VAL;  // (a runaway)
-      if (i >= skip) sum += imp.last_energies().elastic.stretch;
-    }
-    return sum / (steps - skip) / (1.5 * n * kT);
+    return stretch_over_equipartition(ip, 1e-9, 300, 100);
   };
   const double h = run(true), gn = run(false);
   std::printf("  <E_stretch>/equipartition at 1 ns: full Hessian %.3f, Gauss-Newton %.3f\n", h, gn);
