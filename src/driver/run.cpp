@@ -189,7 +189,7 @@ std::string Run::State::progress_line(const sim::Observables& o) const {
   const double ms = ms_per_step();
   const std::int64_t end = sim->end_step();
   char buf[320];
-  if (sim->all_closed())
+  if (sim->link_defined())
     std::snprintf(buf, sizeof buf,
                   "step %lld/%lld  t = %.4f us  Wr = %+.4f  Lk = %+.4f  E_K = %.3e kT  "
                   "%.3f ms/step  ETA %s",
@@ -260,7 +260,7 @@ void Run::State::finish(const sim::Observables& o, const std::string& stop_reaso
     if (error.empty())
       io::write_file_atomic(dir.final_state(), io::final_state_csv(sim->rod(), sim->rod_ranges()));
     if (npy) io::write_velocity_npy(dir.velocity(), c.grid_n, u[0], u[1], u[2]);
-    io::write_file_atomic(dir.summary(), summary_json(user, sim->all_closed(), r, meta,
+    io::write_file_atomic(dir.summary(), summary_json(user, sim->link_defined(), r, meta,
                                                       files->frames(), stop_reason, error));
   });
 }
@@ -483,7 +483,7 @@ RunResult Run::State::loop(const std::function<int()>& pending, std::int64_t max
   }
 
   char buf[512];
-  if (sim->all_closed())
+  if (sim->link_defined())
     std::snprintf(buf, sizeof buf,
                   "ibrod: stopped (%s) after %lld steps, t = %.4f us, Wr = %.4f, Tw = %.4f, "
                   "Lk = %.4f; %.1f s wall, %.3f ms/step",
