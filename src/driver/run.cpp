@@ -504,21 +504,21 @@ RunResult Run::State::loop(const std::function<int()>& pending, std::int64_t max
 
 InitialShapes read_initial_shapes(const config::Config& c) {
   InitialShapes out;
-  const auto read = [&](const config::Config& cr, const std::string& key, int rod) {
+  const auto read = [&](const config::Config& cr, const std::string& key, int rod,
+                        const rod::RodRange& layout) {
     rod::RodState shape = io::read_rod_shape(cr.rod_initial_shape, key, rod);
-    if (const std::string bad =
-            sim::state_problem(shape, cr.rod_base_pairs, cr.rod_rise_A, cr.rod_closed);
-        !bad.empty())
+    if (const std::string bad = sim::state_problem(shape, layout); !bad.empty())
       throw ConfigError(key + " = '" + cr.rod_initial_shape + "': " + bad +
                         " (rod.base_pairs = " + std::to_string(cr.rod_base_pairs) +
                         ", rod.rise_A = " + format_g(cr.rod_rise_A) + " Å)");
     return shape;
   };
   // each rod's own rod.initial_shape ([[rods]] table r: rod r of a file of several rods)
+  const std::vector<rod::RodRange> layout = config::rod_layout(c);
   for (const config::RodConfig& rc : config::rod_configs(c)) {
     out.emplace_back();
     if (!rc.keys.rod_initial_shape.empty())
-      out.back() = read(rc.keys, rc.key("initial_shape"), rc.table);
+      out.back() = read(rc.keys, rc.key("initial_shape"), rc.table, layout[out.size() - 1]);
   }
   // the rods together: no two on top of each other, in the box or across its faces
   const sim::SimParams p = config::to_params(c);
