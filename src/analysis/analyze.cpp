@@ -58,20 +58,15 @@ RunInfo read_run_info(const fs::path& dir) {
   info.diameter_A = tbl["steric"]["diameter_A"].value<double>().value_or(info.diameter_A);
   info.excess_link = tbl["rod"]["excess_link"].value<int>().value_or(info.excess_link);
   info.salt_M = tbl["solvent"]["salt_M"].value<double>().value_or(info.salt_M);
-  info.closed = tbl["rod"]["closed"].value<bool>().value_or(info.closed);
+  const bool closed = tbl["rod"]["closed"].value<bool>().value_or(config::Config().rod_closed);
   const int n = tbl["rod"]["base_pairs"].value<int>().value_or(config::Config().rod_base_pairs);
   const double ds = tbl["rod"]["rise_A"].value<double>().value_or(config::Config().rod_rise_A);
-  info.rods = {{0, n, info.closed, ds}};
+  info.rods = {{0, n, closed, ds}};
   if (tbl.contains("rods")) {
     // [[rods]]: each table resolved on top of [rod], as the run did
     config::Config c;
     config::apply_toml(c, read_text_file(p, "analyze"), p.string());
-    info.rods.clear();
-    int offset = 0;
-    for (const config::RodConfig& rc : config::rod_configs(c)) {
-      info.rods.push_back({offset, rc.keys.rod_base_pairs, rc.keys.rod_closed, rc.keys.rod_rise_A});
-      offset += rc.keys.rod_base_pairs;
-    }
+    info.rods = config::rod_layout(c);
   }
   if (!(info.diameter_A > 0))
     throw ConfigError("'" + p.string() + "': steric.diameter_A must be positive");
@@ -80,7 +75,10 @@ RunInfo read_run_info(const fs::path& dir) {
 
 std::vector<rod::RodRange> RunInfo::layout(int n) const {
   if (rod::total_points(rods) == n) return rods;
-  return {{0, n, closed, rods.front().ds}};
+  rod::RodRange one = rods.front();
+  one.offset = 0;
+  one.n = n;
+  return {one};
 }
 
 // ---- analyze

@@ -29,13 +29,12 @@ struct RunInfo {
   double diameter_A = 20.0;  ///< steric.diameter_A: the tube diameter in pictures
   int excess_link = 0;       ///< rod.excess_link
   double salt_M = 0;         ///< solvent.salt_M
-  bool closed = true;        ///< rod.closed (an open rod: no closing segment, no Wr or ΔLk)
   /// each rod's layout (rod::RodRange), in the state's order: the [[rods]] tables resolved on
-  /// top of [rod], else the one rod of [rod] (rod.base_pairs, rod.closed, rod.rise_A; their
-  /// defaults without config.toml: layout() then fits the frames)
+  /// top of [rod] (config::rod_layout), else the one rod of [rod] (rod.base_pairs, rod.closed,
+  /// rod.rise_A; their defaults without config.toml: layout() then fits the frames)
   std::vector<rod::RodRange> rods{{0, 600, true, 3.4}};
   /// The rods of a frame of n points: `rods`, or where they do not cover n points (no config.toml,
-  /// or one of another run) one rod of all n points, closed as `closed` says.
+  /// or one of another run) one rod of all n points, of the first rod's kind and Δs.
   std::vector<rod::RodRange> layout(int n) const;
 };
 /// Reads DIR/config.toml; defaults (diameter 20 Å) for a missing file or key. A file that is not

@@ -334,15 +334,17 @@ std::vector<fs::path> render_run(const fs::path& dir, const RenderOptions& opt, 
     const std::vector<rod::RodRange> rods = info.layout(int(f.X.size()));
     if (labels) {
       char wr[192], lk[96];
-      // each closed rod's writhe (an open one's twist: docs/model.md "Open rods"), in order
+      // each rod's writhe where it is defined (an open rod's twist: docs/model.md "Open rods"),
+      // in order
       std::string w;
       for (const rod::RodRange& g : rods) {
         const auto at = std::size_t(g.offset), m = std::size_t(g.n);
         const std::span<const Vec3> x = std::span<const Vec3>(f.X).subspan(at, m);
         const std::span<const Vec3> d = std::span<const Vec3>(f.d1).subspan(at, m);
+        const bool wr = diagnostics::link_defined(g);
         char one[40];
-        std::snprintf(one, sizeof one, "%s%s = %.3f", w.empty() ? "" : "  ", g.closed ? "Wr" : "Tw",
-                      g.closed ? diagnostics::writhe(x) : diagnostics::twist_open(x, d));
+        std::snprintf(one, sizeof one, "%s%s = %.3f", w.empty() ? "" : "  ", wr ? "Wr" : "Tw",
+                      wr ? diagnostics::writhe(x) : diagnostics::twist_open(x, d));
         w += one;
       }
       std::snprintf(wr, sizeof wr, "%s", w.substr(0, sizeof wr - 1).c_str());

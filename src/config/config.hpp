@@ -149,6 +149,11 @@ struct RodConfig {
 /// The driver, the files and the analysis walk this list instead of asking whether c has
 /// [[rods]] tables.
 std::vector<RodConfig> rod_configs(const Config& c);
+/// The rods' layout (rod::RodRange: offset, rod.base_pairs, rod.closed, rod.rise_A as Δs) as
+/// rod_configs resolves them, in the state's order, without reading any file (rod.moduli_file):
+/// what rod.initial_shape is checked against and the analysis lays out the frames of a run's
+/// config.toml by.
+std::vector<rod::RodRange> rod_layout(const Config& c);
 /// A message why old's rods cannot be continued as c's (a checkpoint's configuration against the
 /// resumed one: another count of rods, or a rod of another size or kind, closed or open); ""
 /// if they can.

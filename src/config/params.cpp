@@ -275,7 +275,7 @@ rod::RodParams rod_params(const Config& c) {
   if (!r.a_k.empty()) {
     // the scalars become the means over the links in use (n closed, n − 1 open): the twisted
     // circle's tilt sin β (docs/config.md "rod.moduli_file")
-    const int m = rod::half_points(r.n, r.closed);
+    const int m = rod::links(r);
     r.a = r.b = Vec3::Zero();
     for (int k = 0; k < m; ++k) {
       r.a += r.a_k[k] / m;

@@ -671,6 +671,17 @@ std::vector<RodConfig> rod_configs(const Config& c) {
   return out;
 }
 
+std::vector<rod::RodRange> rod_layout(const Config& c) {
+  std::vector<rod::RodRange> out;
+  int offset = 0;
+  for (const RodConfig& rc : rod_configs(c)) {
+    const Config& k = rc.keys;
+    out.push_back({offset, k.rod_base_pairs, k.rod_closed, k.rod_rise_A * units::angstrom});
+    offset += k.rod_base_pairs;
+  }
+  return out;
+}
+
 std::string rods_incompatibility(const Config& old, const Config& c) {
   const std::vector<RodConfig> a = rod_configs(old), b = rod_configs(c);
   bool same = a.size() == b.size();

@@ -219,10 +219,20 @@ double mean_spacing(std::span<const Vec3> X, bool closed) {
   return sum / edges;
 }
 
-RodTopology rod_topology(std::span<const Vec3> X, std::span<const Vec3> d1, bool closed,
-                         int min_separation) {
+bool link_defined(const rod::RodRange& g) { return rod::wraps(g); }
+
+bool link_defined(std::span<const rod::RodRange> rods) {
+  return std::all_of(rods.begin(), rods.end(),
+                     [](const rod::RodRange& g) { return link_defined(g); });
+}
+
+RodTopology rod_topology(std::span<const Vec3> X_all, std::span<const Vec3> d1_all,
+                         const rod::RodRange& g, int min_separation) {
+  const std::size_t at = std::size_t(g.offset), n = std::size_t(g.n);
+  const std::span<const Vec3> X = X_all.subspan(at, n), d1 = d1_all.subspan(at, n);
+  const bool closed = rod::wraps(g);
   RodTopology t{};
-  if (closed) {
+  if (link_defined(g)) {
     t.writhe = writhe(X);
     t.twist = twist(X, d1);
     t.link = t.writhe + t.twist;
@@ -232,8 +242,7 @@ RodTopology rod_topology(std::span<const Vec3> X, std::span<const Vec3> d1, bool
     t.twist = twist_open(X, d1);
   }
   t.closest = closest_approach(X, min_separation, closed);
-  const int n = int(X.size());
-  t.links = closed ? n : (n > 0 ? n - 1 : 0);
+  t.links = rod::links(g);
   t.spacing = mean_spacing(X, closed);
   return t;
 }

@@ -4,6 +4,7 @@
 #include <span>
 
 #include "core/types.hpp"
+#include "rod/rod_set.hpp"
 
 namespace ibrod::diagnostics {
 
@@ -47,16 +48,23 @@ double closest_approach(std::span<const Vec3> X, int min_separation, bool closed
 /// O(n).
 double mean_spacing(std::span<const Vec3> X, bool closed = true);
 
-/// One rod's row of the time series (MODEL §6): writhe, twist and link (link = Wr + Tw) of a
-/// closed rod; an open rod's twist (twist_open), its writhe and link NaN ("not defined": not
-/// topological with free ends; docs/model.md "Open rods"); the closest approach over pairs at
-/// least min_separation apart along the rod, the mean spacing and the count of links (n closed,
-/// n − 1 open). d1: each point's director D¹.
+/// Whether a rod's writhe and linking number are defined: a closed rod's are (topological); an
+/// open rod's free ends can undo them, so they are "not defined" (NaN; docs/model.md "Open
+/// rods"). For several rods: every rod's (the collection's sums of writhe and link are then
+/// defined, and the progress lines and summary.json report them).
+bool link_defined(const rod::RodRange& g);
+bool link_defined(std::span<const rod::RodRange> rods);
+
+/// One rod's row of the time series (MODEL §6): writhe, twist and link (link = Wr + Tw) where
+/// link_defined; else the rod's twist (twist_open), its writhe and link NaN ("not defined"); the
+/// closest approach over pairs at least min_separation apart along the rod, the mean spacing and
+/// the count of links (rod::links). X, d1: the points and their directors D¹ of the whole
+/// collection, of which rod g is X[g.offset] … X[g.offset + g.n − 1].
 struct RodTopology {
   double writhe, twist, link, closest, spacing;  ///< spacing: the mean, Å
   int links;
 };
-RodTopology rod_topology(std::span<const Vec3> X, std::span<const Vec3> d1, bool closed,
+RodTopology rod_topology(std::span<const Vec3> X, std::span<const Vec3> d1, const rod::RodRange& g,
                          int min_separation);
 
 // ---- additions (the pieces the functions above are built from; exposed for tests and debugging)

@@ -189,7 +189,7 @@ std::string Run::State::progress_line(const sim::Observables& o) const {
   const double ms = ms_per_step();
   const std::int64_t end = sim->end_step();
   char buf[320];
-  if (sim->all_closed())
+  if (sim->link_defined())
     std::snprintf(buf, sizeof buf,
                   "step %lld/%lld  t = %.4f us  Wr = %+.4f  Lk = %+.4f  E_K = %.3e kT  "
                   "%.3f ms/step  ETA %s",
@@ -260,7 +260,7 @@ void Run::State::finish(const sim::Observables& o, const std::string& stop_reaso
     if (error.empty())
       io::write_file_atomic(dir.final_state(), io::final_state_csv(sim->rod(), sim->rod_ranges()));
     if (npy) io::write_velocity_npy(dir.velocity(), c.grid_n, u[0], u[1], u[2]);
-    io::write_file_atomic(dir.summary(), summary_json(user, sim->all_closed(), r, meta,
+    io::write_file_atomic(dir.summary(), summary_json(user, sim->link_defined(), r, meta,
                                                       files->frames(), stop_reason, error));
   });
 }
@@ -483,7 +483,7 @@ RunResult Run::State::loop(const std::function<int()>& pending, std::int64_t max
   }
 
   char buf[512];
-  if (sim->all_closed())
+  if (sim->link_defined())
     std::snprintf(buf, sizeof buf,
                   "ibrod: stopped (%s) after %lld steps, t = %.4f us, Wr = %.4f, Tw = %.4f, "
                   "Lk = %.4f; %.1f s wall, %.3f ms/step",
@@ -504,21 +504,21 @@ RunResult Run::State::loop(const std::function<int()>& pending, std::int64_t max
 
 InitialShapes read_initial_shapes(const config::Config& c) {
   InitialShapes out;
-  const auto read = [&](const config::Config& cr, const std::string& key, int rod) {
+  const auto read = [&](const config::Config& cr, const std::string& key, int rod,
+                        const rod::RodRange& layout) {
     rod::RodState shape = io::read_rod_shape(cr.rod_initial_shape, key, rod);
-    if (const std::string bad =
-            sim::state_problem(shape, cr.rod_base_pairs, cr.rod_rise_A, cr.rod_closed);
-        !bad.empty())
+    if (const std::string bad = sim::state_problem(shape, layout); !bad.empty())
       throw ConfigError(key + " = '" + cr.rod_initial_shape + "': " + bad +
                         " (rod.base_pairs = " + std::to_string(cr.rod_base_pairs) +
                         ", rod.rise_A = " + format_g(cr.rod_rise_A) + " Å)");
     return shape;
   };
   // each rod's own rod.initial_shape ([[rods]] table r: rod r of a file of several rods)
+  const std::vector<rod::RodRange> layout = config::rod_layout(c);
   for (const config::RodConfig& rc : config::rod_configs(c)) {
     out.emplace_back();
     if (!rc.keys.rod_initial_shape.empty())
-      out.back() = read(rc.keys, rc.key("initial_shape"), rc.table);
+      out.back() = read(rc.keys, rc.key("initial_shape"), rc.table, layout[out.size() - 1]);
   }
   // the rods together: no two on top of each other, in the box or across its faces
   const sim::SimParams p = config::to_params(c);

@@ -58,7 +58,7 @@ void prepare_output_dir(const io::RunDir& run_dir, bool overwrite, std::optional
 // ---------------------------------------------------------------------------------------------
 // Output files that grow during the run: timeseries.csv, trajectory.h5md, rod.pvd (+ fluid.pvd).
 
-std::string summary_json(const config::Config& c, bool closed, const RunResult& r,
+std::string summary_json(const config::Config& c, bool link_defined, const RunResult& r,
                          const CheckpointMeta& meta, std::int64_t frames,
                          const std::string& stop_reason, const std::string& error) {
   nlohmann::ordered_json j;
@@ -66,16 +66,16 @@ std::string summary_json(const config::Config& c, bool closed, const RunResult& 
   j["time_us"] = time_without_noise(r.time_us);
   j["stop_reason"] = stop_reason;
   j["excess_link"] = c.rod_excess_link;
-  j["closed"] = closed;
+  j["closed"] = link_defined;
   // docs/thermal.md: whether the run had thermal noise, at which temperature, with which seed
   j["thermal"] = c.solvent_thermal;
   j["temperature_K"] = c.solvent_temperature_K;
   j["seed"] = c.run_seed;
   // an open rod has no link: null, "not defined" (docs/outputs.md)
-  j["link_drift"] = closed ? nlohmann::ordered_json(r.final.link - r.initial.link)
-                           : nlohmann::ordered_json(nullptr);
+  j["link_drift"] = link_defined ? nlohmann::ordered_json(r.final.link - r.initial.link)
+                                 : nlohmann::ordered_json(nullptr);
   j["max_link_drift"] =
-      closed ? nlohmann::ordered_json(meta.max_link_drift) : nlohmann::ordered_json(nullptr);
+      link_defined ? nlohmann::ordered_json(meta.max_link_drift) : nlohmann::ordered_json(nullptr);
   j["self_passage_warning"] = meta.self_passage_warning;
   j["self_passage_step"] = meta.self_passage_step >= 0
                                ? nlohmann::ordered_json(meta.self_passage_step)

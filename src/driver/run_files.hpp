@@ -34,9 +34,10 @@ namespace ibrod::driver {
 /// that stale frames or checkpoints never mix with the new run.
 void prepare_output_dir(const io::RunDir& dir, bool overwrite, std::optional<DirLock>& lock);
 
-/// summary.json of a run that stopped (stop_reason) or failed (error non-empty); closed: every
-/// rod is closed (Simulation::all_closed: the link is defined).
-std::string summary_json(const config::Config& c, bool closed, const RunResult& r,
+/// summary.json of a run that stopped (stop_reason) or failed (error non-empty); link_defined:
+/// the collection's link is defined (Simulation::link_defined: every rod closed), written as
+/// summary.json's "closed".
+std::string summary_json(const config::Config& c, bool link_defined, const RunResult& r,
                          const io::CheckpointMeta& meta, std::int64_t frames,
                          const std::string& stop_reason, const std::string& error);
 

@@ -19,6 +19,8 @@ class BlockCyclicCholesky {
   /// cyclic: lower[n−1] = S[0][n−1] is the corner, n ≥ 3; not cyclic: lower[n−1] is not read,
   /// n ≥ 1. Returns false (and holds no factor) if S is not positive definite.
   bool factorize(const std::vector<Mat6>& diag, const std::vector<Mat6>& lower, bool cyclic = true);
+  /// Whether factorize takes a band of n blocks: n ≥ 3 cyclic, n ≥ 1 not.
+  static bool fits(int n, bool cyclic) { return n >= (cyclic ? 3 : 1); }
   /// x ← S⁻¹ x, x of 6n values (a segment of a longer vector too).
   void solve(Eigen::Ref<Eigen::VectorXd> x) const;
   int blocks() const { return n_; }

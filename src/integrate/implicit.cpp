@@ -248,7 +248,7 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
       // block block-cyclic-tridiagonal (closed) or block-tridiagonal (open)
       use_blocks_ = false;
       const bool bands = std::all_of(ranges_.begin(), ranges_.end(), [](const rod::RodRange& g) {
-        return g.n >= (g.closed ? 3 : 1);
+        return BlockCyclicCholesky::fits(g.n, rod::wraps(g));
       });
       const bool overlap = p_.local_mobility == ImplicitParams::LocalMobility::overlap;
       if (p_.block_solver && local && !overlap && p_.gauss_newton && !p_.stiffness_fd &&

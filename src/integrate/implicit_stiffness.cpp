@@ -20,16 +20,18 @@ namespace {
 
 using Eigen::VectorXd;
 
-// Colours of a rod of n points such that two points of one colour are at least 3 apart along
-// the rod (cyclically if closed): perturbing all of them at once changes each F_k, T_k through
-// one of them at most. Greedy: ≤ 5 colours, 3 when n is a multiple of 3 or the rod is open.
-std::vector<int> colouring(int n, bool closed) {
+// Colours of the points of rod g such that two points of one colour are at least 3 apart along
+// the rod (rod::along: round a ring): perturbing all of them at once changes each F_k, T_k
+// through one of them at most. Greedy: ≤ 5 colours, 3 when n is a multiple of 3 or the rod is
+// open.
+std::vector<int> colouring(const rod::RodRange& g) {
+  const int n = g.n;
   std::vector<int> c(n, -1);
   for (int k = 0; k < n; ++k) {
     bool used[8] = {};
     for (int o = -2; o <= 2; ++o) {
-      if (!closed && (k + o < 0 || k + o >= n)) continue;
-      const int j = ((k + o) % n + n) % n;
+      const int j = rod::along(g, k, o);
+      if (j < 0) continue;
       if (o != 0 && c[j] >= 0) used[c[j]] = true;
     }
     int col = 0;
@@ -75,7 +77,7 @@ void for_each_link(const std::vector<rod::RodParams>& rods,
   for (std::size_t r = 0; r < rods.size(); ++r) {
     const rod::RodParams& rp = rods[r];
     const rod::RodRange& g = ranges[r];
-    for (int h = 0; h < rod::half_points(g.n, g.closed); ++h) {
+    for (int h = 0; h < rod::links(g); ++h) {
       const int a = g.offset + h, b = g.offset + (h + 1) % g.n;
       Mat6 JL, JR;
       link_jacobians(rod::half_point_triad(s.D[a], s.D[b]), (s.X[b] - s.X[a]) / rp.ds, rp.ds, JL,
@@ -100,13 +102,12 @@ int add_steric_stiffness(const interactions::StericParams& p, std::span<const Ve
   const int n = int(X.size());
   if (!p.enabled || n < 4 || !(p.diameter > 0) || !(p.stiffness > 0)) return 0;
   // the segments [X_a, X_b] as interactions::Steric lists them: each rod's own, in order
-  std::vector<rod::RodRange> chains = p.rods;
-  if (chains.empty()) chains.push_back({0, n, p.closed, p.ds});
+  const std::vector<rod::RodRange> chains = interactions::steric_rods(p, n);
   std::vector<int> seg_a, seg_b, seg_chain, seg_pos;
   for (std::size_t r = 0; r < chains.size(); ++r) {
     const rod::RodRange& c = chains[r];
     if (c.n < 2) continue;
-    for (int k = 0; k < rod::half_points(c.n, c.closed); ++k) {
+    for (int k = 0; k < rod::links(c); ++k) {
       seg_a.push_back(c.offset + k);
       seg_b.push_back(c.offset + (k + 1) % c.n);
       seg_chain.push_back(int(r));
@@ -118,8 +119,7 @@ int add_steric_stiffness(const interactions::StericParams& p, std::span<const Ve
   auto far_along_rod = [&](int k, int l) {
     if (seg_chain[k] != seg_chain[l]) return true;
     const rod::RodRange& c = chains[std::size_t(seg_chain[k])];
-    const int m = std::abs(seg_pos[k] - seg_pos[l]);
-    return (c.closed ? std::min(m, c.n - m) : m) * c.ds > 2 * p.diameter;
+    return rod::arc_separation(c, seg_pos[k], seg_pos[l]) * c.ds > 2 * p.diameter;
   };
   std::vector<Vec3> mid(ns);
   double lmax2 = 0;
@@ -227,7 +227,7 @@ Eigen::SparseMatrix<double> ImplicitStepper::stiffness(const rod::RodState& s) {
   if (p_.gauss_newton && !p_.stiffness_fd) {
     gn_blocks(s);
     for (const rod::RodRange& g : ranges_) {
-      const int links = rod::half_points(g.n, g.closed);
+      const int links = rod::links(g);
       for (int h = 0; h < g.n; ++h) {
         const int a = g.offset + h, b = g.offset + (h + 1) % g.n;
         for (int r = 0; r < 6; ++r)
@@ -256,20 +256,16 @@ void ImplicitStepper::fd_stiffness(const rod::RodState& all, std::size_t rod_ind
   const rod::RodParams& rp = rods_[rod_index];
   const rod::RodRange& g = ranges_[rod_index];
   const int n = g.n, off = g.offset;
-  const bool closed = g.closed;
-  const int links = rod::half_points(n, closed);
+  const int links = rod::links(g);
   rod::RodState s;
   rod::extract(all, g, s);
   pert_ = s;
   work_.resize(n);
   for (auto* v : {&Fa_, &Ta_, &Fb_, &Tb_}) v->assign(n, Vec3::Zero());
-  const std::vector<int> col = colouring(n, closed);
+  const std::vector<int> col = colouring(g);
   const int ncol = *std::max_element(col.begin(), col.end()) + 1;
   // the neighbour of point j at offset o along the rod (−1: past an open rod's end)
-  auto along = [&](int j, int o) {
-    if (!closed && (j + o < 0 || j + o >= n)) return -1;
-    return ((j + o) % n + n) % n;
-  };
+  auto along = [&](int j, int o) { return rod::along(g, j, o); };
   // Gauss–Newton: the stress resultants of half point h, σ_h = (D_hᵀF_h, D_hᵀN_h) = C (ε_h − ε₀),
   // and their derivatives S_L = ∂σ_h/∂q_h, S_R = ∂σ_h/∂q_{h+1} by the same differences
   using Mat6 = Eigen::Matrix<double, 6, 6>;
@@ -410,7 +406,7 @@ void ImplicitStepper::factorize(double dt) {
         for (int i = 0; i < 6; ++i) diag[j](i, i) += 1.0 / mloc_[6 * k + i];
         lower[j] = dt * Ko_[k];
       }
-      if (!bcc_[r].factorize(diag, lower, g.closed))
+      if (!bcc_[r].factorize(diag, lower, rod::wraps(g)))
         throw std::runtime_error("ImplicitStepper: the local implicit system is not positive");
     });
     lu_dt_ = dt;

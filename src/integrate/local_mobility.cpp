@@ -38,8 +38,8 @@ Eigen::SparseMatrix<double> kernel_overlap(std::span<const Vec3> X, const GridSp
     if (rod::total_points(rods) != n)
       throw std::invalid_argument("kernel_overlap: the rods' points are not X's");
     rod::for_each_rod(rods, [&](std::size_t r, const rod::RodRange& g) {
-      if (g.closed && g.n < 2 * window)
-        throw std::invalid_argument("kernel_overlap: a closed chain of " + std::to_string(g.n) +
+      if (rod::wraps(g) && g.n < 2 * window)
+        throw std::invalid_argument("kernel_overlap: a ring of " + std::to_string(g.n) +
                                     " points is shorter than twice the taper's window " +
                                     std::to_string(window));
       for (int k = 0; k < g.n; ++k) {
@@ -64,8 +64,7 @@ Eigen::SparseMatrix<double> kernel_overlap(std::span<const Vec3> X, const GridSp
     if (window <= 0) return 1.0;
     if (rod_of[j] != rod_of[k]) return 0.0;  // two rods: dropped
     const rod::RodRange& g = rods[std::size_t(rod_of[j])];
-    const int a = std::abs(along[k] - along[j]);
-    const int d = g.closed ? std::min(a, g.n - a) : a;
+    const int d = rod::arc_separation(g, along[j], along[k]);
     return 1 - d / window;
   };
   // the points by the x index of their stencil (counting sort), so that each point meets only

@@ -39,14 +39,14 @@ namespace ibrod::integrate {
 Eigen::SparseMatrix<double> kernel_overlap(std::span<const Vec3> X, const GridSpec& grid, int m);
 
 /// The overlap of the points of rods laid end to end (rod::RodRange, covering X), tapered along
-/// each rod with the distance d = |j − k| along it (closed: min(|j − k|, n − |j − k|)): block (j,
-/// k) of two points of one rod times max(0, 1 − d/window); of two rods, 0 (as far apart along a rod
-/// as can be). The taper is a positive semi-definite matrix on each rod (its spectrum is a Fejér
-/// kernel; closed rods need n ≥ 2·window), zero between them, so the Schur product stays positive
-/// semi-definite (Schur's product theorem). With a window wider than the kernel's reach along the
-/// rod (4c / spacing points) it keeps each rod's own overlap nearly whole and drops that of
-/// strands far apart along the rod but close in space, which would make the local system's
-/// factorisation no longer banded. window ≤ 0: no taper (the rods are then not read).
+/// each rod with the distance d along it (rod::arc_separation: |j − k|, round a ring the shorter
+/// way): block (j, k) of two points of one rod times max(0, 1 − d/window); of two rods, 0 (as far
+/// apart along a rod as can be). The taper is a positive semi-definite matrix on each rod (its
+/// spectrum is a Fejér kernel; closed rods need n ≥ 2·window), zero between them, so the Schur
+/// product stays positive semi-definite (Schur's product theorem). With a window wider than the
+/// kernel's reach along the rod (4c / spacing points) it keeps each rod's own overlap nearly whole
+/// and drops that of strands far apart along the rod but close in space, which would make the local
+/// system's factorisation no longer banded. window ≤ 0: no taper (the rods are then not read).
 Eigen::SparseMatrix<double> kernel_overlap(std::span<const Vec3> X, const GridSpec& grid, int m,
                                            double window, const std::vector<rod::RodRange>& rods);
 

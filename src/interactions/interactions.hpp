@@ -171,6 +171,11 @@ struct StericParams {
   std::vector<rod::RodRange> rods;
 };
 
+/// The rods whose segments the hard core sees in a list of n points: p.rods, or where it is empty
+/// one rod of all n points with p.ds and p.closed. Steric and the implicit scheme's contact
+/// stiffness (integrate::detail::add_steric_stiffness) both walk these.
+std::vector<rod::RodRange> steric_rods(const StericParams& p, int n);
+
 /// Hard-core repulsion between non-neighbouring segments [X_k, X_{k+1}] of the rod (closed: k =
 /// 0 … n−1, X_n = X_0; open, StericParams::closed = false: k = 0 … n−2), and with several rods
 /// (StericParams::rods) between every two segments of different rods as well:

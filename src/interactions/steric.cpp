@@ -80,10 +80,14 @@ double steric_pair(double D, double g, const Vec3& P0, const Vec3& P1, const Vec
   return 0.5 * g * overlap * overlap;  // MODEL (2.17)
 }
 
+std::vector<rod::RodRange> steric_rods(const StericParams& p, int n) {
+  if (!p.rods.empty()) return p.rods;
+  return {{0, n, p.closed, p.ds}};
+}
+
 void Steric::build_segments(int n) const {
   if (seg_built_for_ == n) return;
-  std::vector<rod::RodRange> chains = p_.rods;
-  if (chains.empty()) chains.push_back({0, n, p_.closed, p_.ds});
+  std::vector<rod::RodRange> chains = steric_rods(p_, n);
   int count = 0;
   for (const rod::RodRange& c : chains) {
     if (c.offset != count || c.n < 0)
@@ -100,8 +104,7 @@ void Steric::build_segments(int n) const {
   for (std::size_t r = 0; r < chains.size(); ++r) {
     const rod::RodRange& c = chains[r];
     if (c.n < 2) continue;
-    const int ns = c.closed ? c.n : c.n - 1;  // closed: the last one X_{n−1} → X_0
-    for (int k = 0; k < ns; ++k) {
+    for (int k = 0; k < rod::links(c); ++k) {  // a ring's last one X_{n−1} → X_0
       seg_a_.push_back(c.offset + k);
       seg_b_.push_back(c.offset + (k + 1) % c.n);
       seg_chain_.push_back(int(r));
@@ -117,8 +120,7 @@ void Steric::build_segments(int n) const {
 bool Steric::far_along_rod(int k, int l) const {
   if (seg_chain_[k] != seg_chain_[l]) return true;
   const rod::RodRange& c = chains_[seg_chain_[k]];
-  const int m = std::abs(seg_pos_[k] - seg_pos_[l]);
-  return (c.closed ? std::min(m, c.n - m) : m) * c.ds > 2 * p_.diameter;
+  return rod::arc_separation(c, seg_pos_[k], seg_pos_[l]) * c.ds > 2 * p_.diameter;
 }
 
 // Segment pair k, l: adds the forces on their end points into F (indexed by point); returns the

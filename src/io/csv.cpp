@@ -12,6 +12,7 @@
 
 #include "core/error.hpp"
 #include "core/text_file.hpp"
+#include "diagnostics/topology.hpp"
 
 namespace ibrod::io {
 
@@ -136,7 +137,8 @@ std::vector<RodColumn> rod_columns(std::span<const rod::RodRange> rods) {
   });
   std::size_t q = 0;  // the pair's place in Observables::pair_links
   rod::for_each_pair(rods, [&](std::size_t a, std::size_t b) {
-    if (!rods[a].closed || !rods[b].closed) return;
+    // the pairs Simulation::observe fills: both links defined
+    if (!diagnostics::link_defined(rods[a]) || !diagnostics::link_defined(rods[b])) return;
     c.push_back(
         {"link_" + std::to_string(a) + "_" + std::to_string(b), [q](const sim::Observables& o) {
            return q < o.pair_links.size() ? o.pair_links[q]

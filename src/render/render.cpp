@@ -184,15 +184,13 @@ Image render_rods(std::span<const Vec3> X, std::span<const Vec3> d1,
   std::vector<long> next(n, -1), prev(n, -1);
   std::vector<int> rod_of(n, 0);
   std::vector<double> rod_len;
-  std::vector<bool> rod_closed;
   rod::for_each_rod(rods, [&](std::size_t r, const rod::RodRange& g) {
-    const std::size_t off = std::size_t(g.offset), m = std::size_t(g.n);
+    const std::size_t off = std::size_t(g.offset);
     rod_len.push_back(0.0);
-    rod_closed.push_back(g.closed);
-    for (std::size_t k = 0; k < m; ++k) {
-      rod_of[off + k] = int(r);
-      if (k + 1 < m || g.closed) next[off + k] = long(off + (k + 1) % m);
-      if (k > 0 || g.closed) prev[off + k] = long(off + (k + m - 1) % m);
+    for (int k = 0; k < g.n; ++k) {  // −1: past an open rod's end
+      rod_of[off + std::size_t(k)] = int(r);
+      if (const int a = rod::after(g, k); a >= 0) next[off + std::size_t(k)] = long(off) + a;
+      if (const int b = rod::before(g, k); b >= 0) prev[off + std::size_t(k)] = long(off) + b;
     }
   });
   // segments k → next[k]: n of a closed polygon, n − 1 of an open one, per rod
@@ -215,12 +213,14 @@ Image render_rods(std::span<const Vec3> X, std::span<const Vec3> d1,
     std::size_t off = 0;
     for (const rod::RodRange& g : rods) {
       const std::size_t m = std::size_t(g.n);
-      const bool closed_r = g.closed;
       const auto tw = twist_density(X.subspan(off, m), d1.subspan(off, m));
-      for (std::size_t k = 0; k < m; ++k) tw_point[off + k] = 0.5 * (tw[(k + m - 1) % m] + tw[k]);
-      if (!closed_r) {  // the ends have one segment each
-        tw_point[off] = tw[0];
-        tw_point[off + m - 1] = tw[m - 2];
+      // the mean of the point's two segments: segment k starts at point k, the one before it
+      // (from point b) ends there; an open rod's ends have one segment each
+      for (int k = 0; k < g.n; ++k) {
+        const int b = rod::before(g, k), a = rod::after(g, k);
+        tw_point[off + std::size_t(k)] = b >= 0 && a >= 0
+                                             ? 0.5 * (tw[std::size_t(b)] + tw[std::size_t(k)])
+                                             : tw[std::size_t(b >= 0 ? b : k)];
       }
       off += m;
     }
@@ -302,9 +302,8 @@ Image render_rods(std::span<const Vec3> X, std::span<const Vec3> d1,
   // two hits far apart along the rod: on different rods, or on one rod more than arc_gap apart
   const auto far_along = [&](std::size_t i1, std::size_t i2) {
     if (rod_hit[i1] != rod_hit[i2]) return true;
-    const int r = rod_hit[i1];
-    const double ds = std::abs(double(arc[i1]) - double(arc[i2]));
-    return (rod_closed[r] ? std::min(ds, rod_len[r] - ds) : ds) > arc_gap;
+    const std::size_t r = std::size_t(rod_hit[i1]);
+    return rod::arc_distance(rods[r], double(arc[i1]), double(arc[i2]), rod_len[r]) > arc_gap;
   };
   if (style.outline_darken < 1) {
     const int reach = S;

@@ -4,7 +4,10 @@
 // coupling and the pair forces see one list of points; each rod keeps its own RodParams (its n,
 // Δs, moduli, intrinsic strains, closed or open) and its elastic forces are computed on its own
 // range. The helpers here cut a rod out of the whole state and place a shape in the box.
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
+#include <cstdlib>
 #include <span>
 #include <string>
 #include <vector>
@@ -26,6 +29,45 @@ struct RodRange {
 
 /// The ranges of rods laid end to end, in order (each rod's n, closed and Δs).
 std::vector<RodRange> ranges_of(std::span<const RodParams> rods);
+
+// ---- A rod's kind, closed ring or open rod, answered here once: the kernels callers take
+// instead of branching on RodRange::closed (ARCHITECTURE.md "How many places a kind of rod or a
+// count of rods reaches"). Point indices k are the rod's own, 0 … n − 1 (add g.offset for the
+// whole state's).
+
+/// Whether the rod wraps round: a ring, its last point linked back to its first (X_n = X_0), so
+/// that every band along it (the implicit scheme's stiffness) is cyclic.
+inline bool wraps(const RodRange& g) { return g.closed; }
+/// The rod's links (half points k+½, segments X_k → X_{k+1}, k = 0 … links − 1): n of a ring,
+/// n − 1 of an open rod (0 for no points).
+inline int links(const RodRange& g) { return half_points(g.n, g.closed); }
+inline int links(const RodParams& r) { return half_points(r.n, r.closed); }
+/// The point o steps along rod g from its point k (o < 0: backwards): round a ring modulo n,
+/// −1 past an open rod's ends.
+inline int along(const RodRange& g, int k, int o) {
+  if (!g.closed) return k + o >= 0 && k + o < g.n ? k + o : -1;
+  return ((k + o) % g.n + g.n) % g.n;
+}
+/// The point before k, after k (along(g, k, ∓1)): −1 past an open rod's ends.
+inline int before(const RodRange& g, int k) { return along(g, k, -1); }
+inline int after(const RodRange& g, int k) { return along(g, k, 1); }
+/// The points of a central difference at k: before / after k, or k itself at an open rod's end
+/// (one-sided there): point_before / point_after of the rod's n and kind.
+inline int point_before(const RodRange& g, int k) { return point_before(k, g.n, g.closed); }
+inline int point_after(const RodRange& g, int k) { return point_after(k, g.n, g.closed); }
+/// How far apart along rod g its points (or links) i and j are, in steps: |i − j|, round a ring
+/// the shorter way, min(|i − j|, n − |i − j|).
+inline int arc_separation(const RodRange& g, int i, int j) {
+  const int m = std::abs(i - j);
+  return g.closed ? std::min(m, g.n - m) : m;
+}
+/// The same for two places a, b along rod g given by their arc lengths from its first point, the
+/// rod's length (its links' lengths summed) `length`: |a − b|, round a ring the shorter way,
+/// min(|a − b|, length − |a − b|).
+inline double arc_distance(const RodRange& g, double a, double b, double length) {
+  const double d = std::abs(a - b);
+  return g.closed ? std::min(d, length - d) : d;
+}
 
 // ---- The operations callers outside src/rod take instead of asking how many rods there are
 // (ARCHITECTURE.md "How many places a kind of rod or a count of rods reaches"): they loop over the

@@ -14,19 +14,31 @@ double spacing_tolerance(const rod::RodParams& rod, double thermal_kT) {
   if (!(thermal_kT > 0)) return 0.5;
   double b = rod.b.minCoeff();  // the softest shear or stretch (per link: rod.moduli_file)
   if (!rod.b_k.empty())         // the links in use (an open rod's last row is not)
-    for (int k = 0; k < rod::half_points(rod.n, rod.closed); ++k)
-      b = std::min(b, rod.b_k[k].minCoeff());
+    for (int k = 0; k < rod::links(rod); ++k) b = std::min(b, rod.b_k[k].minCoeff());
   return std::max(0.5, 7.0 * std::sqrt(thermal_kT * rod.ds / b) / rod.ds);
 }
 
-std::string rod_problem(const rod::RodState& s, double ds, double tolerance, bool closed) {
-  return rod_problem(s.X, s.D, ds, tolerance, closed);
+namespace {
+// A ring of n points Δs = ds apart (RodRange's default kind), at the start of its state.
+rod::RodRange ring(int n, double ds) {
+  rod::RodRange g{0, n};
+  g.ds = ds;
+  return g;
+}
+}  // namespace
+
+std::string rod_problem(const rod::RodState& s, double ds, double tolerance) {
+  return rod_problem(s.X, s.D, ring(s.size(), ds), tolerance);
 }
 
-std::string rod_problem(std::span<const Vec3> X, std::span<const Mat3> D, double ds,
-                        double tolerance, bool closed) {
+std::string rod_problem(std::span<const Vec3> X_all, std::span<const Mat3> D_all,
+                        const rod::RodRange& g, double tolerance) {
   const double lo = std::max(0.05, 1.0 - tolerance), hi = 1.0 + tolerance;
-  const int n = int(X.size());
+  const std::size_t at = std::size_t(g.offset), m = std::size_t(g.n);
+  const std::span<const Vec3> X = X_all.subspan(at, m);
+  const std::span<const Mat3> D = D_all.subspan(at, m);
+  const double ds = g.ds;
+  const int n = g.n;
   char buf[256];
   for (int k = 0; k < n; ++k) {
     if (!X[k].allFinite()) {
@@ -36,8 +48,8 @@ std::string rod_problem(std::span<const Vec3> X, std::span<const Mat3> D, double
     }
     if (!D[k].allFinite()) return "the triad of point " + std::to_string(k) + " is not finite";
   }
-  for (int k = 0; k < rod::half_points(n, closed); ++k) {
-    const int k1 = k + 1 == n ? 0 : k + 1;
+  for (int k = 0; k < rod::links(g); ++k) {
+    const int k1 = rod::after(g, k);
     const double r = (X[k1] - X[k]).norm() / ds;
     if (!(r >= lo && r <= hi)) {
       std::snprintf(buf, sizeof buf,
@@ -58,11 +70,18 @@ std::string rod_problem(std::span<const Vec3> X, std::span<const Mat3> D, double
   return {};
 }
 
-std::string state_problem(const rod::RodState& s, int n, double ds, bool closed) {
+std::string state_problem(const rod::RodState& s, int n, double ds) {
+  return state_problem(s, ring(n, ds));
+}
+
+std::string state_problem(const rod::RodState& s, const rod::RodRange& rod_range) {
+  rod::RodRange g = rod_range;  // s holds the rod alone
+  g.offset = 0;
+  const int n = g.n;
   if (s.size() != n || int(s.D.size()) != n)
     return std::to_string(s.size()) + " positions and " + std::to_string(s.D.size()) +
            " triads; the rod has " + std::to_string(n) + " points (rod.base_pairs)";
-  if (std::string bad = rod_problem(s, ds, 0.5, closed); !bad.empty()) return bad;
+  if (std::string bad = rod_problem(s.X, s.D, g, 0.5); !bad.empty()) return bad;
   for (int k = 0; k < n; ++k)
     if (const double det = s.D[k].determinant(); !(det > 0)) {
       char buf[160];
@@ -74,7 +93,7 @@ std::string state_problem(const rod::RodState& s, int n, double ds, bool closed)
   // D³ along the rod: an orthonormal triad with its rows and columns swapped passes the checks
   // above, and the run then blows up at its first step
   for (int k = 0; k < n; ++k) {
-    const int prev = rod::point_before(k, n, closed), next = rod::point_after(k, n, closed);
+    const int prev = rod::point_before(g, k), next = rod::point_after(g, k);
     const Vec3 t = s.X[next] - s.X[prev];  // central; one-sided at an open rod's ends
     const double c = t.dot(s.D[k].col(2)) / t.norm();
     if (!(c >= kMinTangentCosine)) {
@@ -109,11 +128,8 @@ std::string rods_problem(std::span<const rod::RodParams> rods, const rod::RodSta
   const std::span<const Mat3> D(s.D);
   std::string bad;  // the first rod's problem
   rod::for_each_range(rods, [&](std::size_t r, const rod::RodRange& g) {
-    const std::size_t at = std::size_t(g.offset), m = std::size_t(g.n);
     if (!bad.empty()) return;
-    if (std::string b =
-            rod_problem(X.subspan(at, m), D.subspan(at, m), g.ds, tolerances[r], g.closed);
-        !b.empty())
+    if (std::string b = rod_problem(X, D, g, tolerances[r]); !b.empty())
       bad = rod::message_prefix(rods, r) + b;
   });
   return bad;
@@ -128,8 +144,7 @@ std::string rods_state_problem(std::span<const rod::RodParams> rods, const rod::
   rod::for_each_rod(ranges, [&](std::size_t r, const rod::RodRange& g) {
     if (!bad.empty()) return;
     rod::extract(s, g, one);
-    if (std::string b = state_problem(one, g.n, g.ds, g.closed); !b.empty())
-      bad = rod::message_prefix(ranges, r) + b;
+    if (std::string b = state_problem(one, g); !b.empty()) bad = rod::message_prefix(ranges, r) + b;
   });
   // two rods must not start on top of each other (coincident charges, crossed hard cores)
   rod::for_each_pair(ranges, [&](std::size_t a, std::size_t b) {

@@ -4,18 +4,20 @@
 #include <string>
 
 #include "rod/rod.hpp"
+#include "rod/rod_set.hpp"
 
 namespace ibrod::sim {
 
-/// Empty if the rod is sane; otherwise what is wrong, naming the point: a non-finite position or
-/// triad, an adjacent spacing off Δs by more than `tolerance` (relative; 50 % by default; never
-/// below 0.05 Δs), a triad off orthonormal by more than 1e-3. closed = false (an open rod): no
-/// spacing between the last point and the first.
-std::string rod_problem(const rod::RodState& s, double ds, double tolerance = 0.5,
-                        bool closed = true);
-/// The same on the points X and triads D of one rod (a range of a state of several rods).
-std::string rod_problem(std::span<const Vec3> X, std::span<const Mat3> D, double ds,
-                        double tolerance, bool closed);
+/// Empty if the ring `s` (all its points, Δs = ds apart) is sane; otherwise what is wrong, naming
+/// the point: a non-finite position or triad, the spacing of a link off Δs by more than
+/// `tolerance` (relative; 50 % by default; never below 0.05 Δs), a triad off orthonormal by more
+/// than 1e-3.
+std::string rod_problem(const rod::RodState& s, double ds, double tolerance = 0.5);
+/// The same for rod g (its Δs and links: an open rod has none between its last point and its
+/// first) of the points X and triads D of a state of one or several rods; points are numbered
+/// within the rod.
+std::string rod_problem(std::span<const Vec3> X, std::span<const Mat3> D, const rod::RodRange& g,
+                        double tolerance);
 
 /// The spacing tolerance of rod_problem for a run: 0.5, or with thermal noise (docs/thermal.md)
 /// seven standard deviations of the thermal stretch or shear of one segment,
@@ -23,11 +25,14 @@ std::string rod_problem(std::span<const Vec3> X, std::span<const Mat3> D, double
 /// · 7/6 for the reference parameters: a 50 % stretch is a 3σ event there, not a blow-up).
 double spacing_tolerance(const rod::RodParams& rod, double thermal_kT);
 
-/// Empty if `s` may be a rod of n points Δs = ds apart (an initial shape, a state set from
-/// Python); otherwise what is wrong: a count of positions or triads other than n, what
-/// rod_problem finds, a left-handed triad (det D < 0: D³ must be D¹ × D²), or a D³ more than
-/// 60° off the tangent X[k+1] − X[k−1] (one-sided at an open rod's ends).
-std::string state_problem(const rod::RodState& s, int n, double ds, bool closed = true);
+/// Empty if `s` may be the rod laid out as g (g.n points, g.ds apart, its kind; g.offset is not
+/// read: s holds that rod alone; an initial shape, a state set from Python); otherwise what is
+/// wrong: a count of positions or triads other than g.n, what rod_problem finds, a left-handed
+/// triad (det D < 0: D³ must be D¹ × D²), or a D³ more than 60° off the tangent X[k+1] − X[k−1]
+/// (one-sided at an open rod's ends).
+std::string state_problem(const rod::RodState& s, const rod::RodRange& g);
+/// The same for a ring of n points Δs = ds apart.
+std::string state_problem(const rod::RodState& s, int n, double ds);
 
 /// The same for the rods of a state of one or several rods laid end to end (rod::RodRange): each
 /// rod checked in place on its own points with its own Δs, end condition and spacing tolerance

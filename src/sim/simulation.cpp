@@ -245,13 +245,11 @@ Observables Simulation::observe() {
   const std::span<const Mat3> D(rod_.D);
   double closest = HUGE_VAL;
   int links = 0;
-  std::vector<Vec3> d1;  // a rod's directors D¹
+  std::vector<Vec3> d1(D.size());  // the directors D¹
+  for (std::size_t k = 0; k < D.size(); ++k) d1[k] = D[k].col(0);
   for (const rod::RodRange& g : ranges) {
-    const std::size_t at = std::size_t(g.offset), n = std::size_t(g.n);
-    d1.resize(n);
-    for (std::size_t k = 0; k < n; ++k) d1[k] = D[at + k].col(0);
     const diagnostics::RodTopology t =
-        diagnostics::rod_topology(X.subspan(at, n), d1, g.closed, p_.closest_min_separation);
+        diagnostics::rod_topology(X, d1, g, p_.closest_min_separation);
     o.rods.push_back({t.writhe, t.twist, t.link});
     o.writhe += t.writhe;
     o.twist += t.twist;
@@ -266,7 +264,7 @@ Observables Simulation::observe() {
     for (int i = 0; i < ga.n; ++i)
       for (int j = 0; j < gb.n; ++j)
         closest = std::min(closest, (X[ga.offset + i] - X[gb.offset + j]).norm());
-    if (ga.closed && gb.closed)
+    if (diagnostics::link_defined(ga) && diagnostics::link_defined(gb))
       o.pair_links.push_back(
           diagnostics::linking_number(X.subspan(std::size_t(ga.offset), std::size_t(ga.n)),
                                       X.subspan(std::size_t(gb.offset), std::size_t(gb.n))));

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "diagnostics/topology.hpp"
 #include "integrate/implicit.hpp"
 #include "integrate/stepper.hpp"
 #include "integrate/system.hpp"
@@ -144,12 +145,10 @@ class Simulation {
   const std::vector<rod::RodParams>& rods() const { return system_.rods(); }
   /// Where each rod lies in rod() (rod::RodRange).
   const std::vector<rod::RodRange>& rod_ranges() const { return system_.ranges(); }
-  /// Whether every rod is closed: the collection's link and writhe are defined (sums of each
-  /// rod's), so the progress lines and summary.json report them; else "not defined".
-  bool all_closed() const {
-    return std::all_of(rods().begin(), rods().end(),
-                       [](const rod::RodParams& r) { return r.closed; });
-  }
+  /// Whether the collection's link and writhe are defined (diagnostics::link_defined of every
+  /// rod; they are the sums of each rod's), so the progress lines and summary.json report them;
+  /// else "not defined".
+  bool link_defined() const { return diagnostics::link_defined(rod_ranges()); }
   /// What is wrong with the state, "" if nothing (sim::rods_problem: each rod's spacing, triads,
   /// finiteness; the spacing tolerance widened for thermal noise).
   std::string state_check() const;

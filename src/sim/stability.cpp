@@ -18,9 +18,10 @@ namespace {
 
 double uniform01(std::mt19937_64& g) { return double(g() >> 11) * 0x1.0p-53; }
 
-// The kick of step 3 (see the header), drawn from g: positions out of the mean plane, triads
-// turned with their tangents, then the twist.
-void kick(rod::RodState& s, bool closed, const StabilityProbe& p, std::mt19937_64& g) {
+// The kick of step 3 (see the header) of the rod laid out as rod_range (s holds it alone), drawn
+// from g: positions out of the mean plane, triads turned with their tangents, then the twist.
+void kick(rod::RodState& s, const rod::RodRange& rod_range, const StabilityProbe& p,
+          std::mt19937_64& g) {
   const int n = s.size();
   const double phi2 = 2 * std::numbers::pi * uniform01(g);
   const double u3 = 2 * uniform01(g) - 1;
@@ -41,7 +42,7 @@ void kick(rod::RodState& s, bool closed, const StabilityProbe& p, std::mt19937_6
     const Vec3 e1 = eig.eigenvectors().col(2), e2 = eig.eigenvectors().col(1);
     // central differences; one-sided at the free ends of an open rod
     auto tangent = [&](const std::vector<Vec3>& X, int k) {
-      const int a = rod::point_before(k, n, closed), b = rod::point_after(k, n, closed);
+      const int a = rod::point_before(rod_range, k), b = rod::point_after(rod_range, k);
       return Vec3(X[std::size_t(b)] - X[std::size_t(a)]).normalized();
     };
     std::vector<Vec3> X = s.X;
@@ -133,7 +134,7 @@ ProbeOutcome probe_stability(Simulation& sim, const StabilityProbe& p, std::uint
   rod::RodState one;
   for (const rod::RodRange& r : sim.rod_ranges()) {
     rod::extract(sim.rod(), r, one);
-    kick(one, r.closed, p, g);
+    kick(one, r, p, g);
     rod::insert(sim.rod(), r, one);
   }
   o.steps = integrate(sim, saved_time, p.time, kicked);

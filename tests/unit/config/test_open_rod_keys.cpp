@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <vector>
 
 #include "config/config.hpp"
 #include "core/error.hpp"
@@ -82,4 +83,41 @@ TEST(OpenRodKeys, TheStraightRodMustFitInTheBox) {
   EXPECT_EQ(validation_error(c), "");
   config::apply_override(c, "rod.base_pairs=210");  // 709.6 + 20 ≥ 725
   EXPECT_THAT(validation_error(c), HasSubstr("grid.box_A"));
+}
+
+// config::rod_layout: the rods' layout as rod_configs resolves them, without reading any file.
+TEST(RodLayout, OneRodOrTheRodsTablesEndToEnd) {
+  config::Config c;
+  config::apply_override(c, "rod.closed=false");
+  config::apply_override(c, "rod.base_pairs=120");
+  const std::vector<rod::RodRange> one = config::rod_layout(c);
+  ASSERT_EQ(one.size(), 1u);
+  EXPECT_EQ(one[0].offset, 0);
+  EXPECT_EQ(one[0].n, 120);
+  EXPECT_FALSE(one[0].closed);
+  EXPECT_EQ(one[0].ds, c.rod_rise_A);
+  config::Config f;
+  config::apply_toml(
+      f,
+      "[rod]\nbase_pairs = 50\n[[rods]]\nexcess_link = 0\n[[rods]]\nbase_pairs = 30\n"
+      "closed = false\nexcess_link = 0\nrise_A = 3.3\n",
+      "f.toml");
+  const std::vector<rod::RodRange> two = config::rod_layout(f);
+  ASSERT_EQ(two.size(), 2u);
+  EXPECT_EQ(two[0].offset, 0);
+  EXPECT_EQ(two[0].n, 50);
+  EXPECT_TRUE(two[0].closed);
+  EXPECT_EQ(two[1].offset, 50);
+  EXPECT_EQ(two[1].n, 30);
+  EXPECT_FALSE(two[1].closed);
+  EXPECT_EQ(two[1].ds, 3.3);
+  // the layout of the parameters a run gets (config::to_params), field by field
+  const std::vector<rod::RodRange> run = rod::ranges_of(config::to_params(f).stepper.rods);
+  ASSERT_EQ(run.size(), two.size());
+  for (std::size_t r = 0; r < run.size(); ++r) {
+    EXPECT_EQ(run[r].offset, two[r].offset);
+    EXPECT_EQ(run[r].n, two[r].n);
+    EXPECT_EQ(run[r].closed, two[r].closed);
+    EXPECT_EQ(run[r].ds, two[r].ds);
+  }
 }

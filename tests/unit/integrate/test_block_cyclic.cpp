@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <stdexcept>
 
 #include "integrate/block_cyclic.hpp"
 
@@ -89,6 +90,30 @@ TEST(BlockCyclicCholesky, RefusesAnIndefiniteMatrix) {
   EXPECT_THROW(c.solve(x), std::logic_error);
   EXPECT_FALSE(c.factorize(diag, lower, false));
   EXPECT_THROW(c.solve(x), std::logic_error);
+}
+
+// fits(n, cyclic), the band the implicit scheme asks about before it takes the block solver:
+// exactly the sizes factorize takes (a cyclic band needs its corner apart from the band).
+TEST(BlockCyclicCholesky, FitsExactlyTheBandsItFactorises) {
+  for (bool cyclic : {true, false})
+    for (int n = 1; n <= 5; ++n) {
+      std::mt19937_64 rng(10 * n + cyclic);
+      std::vector<Mat6> diag, lower;
+      random_blocks(n, cyclic, rng, diag, lower);
+      BlockCyclicCholesky c;
+      bool factorised = false;
+      try {
+        factorised = c.factorize(diag, lower, cyclic);
+      } catch (const std::invalid_argument&) {
+        factorised = false;
+      }
+      EXPECT_EQ(BlockCyclicCholesky::fits(n, cyclic), factorised)
+          << "n " << n << " cyclic " << cyclic;
+    }
+  EXPECT_FALSE(BlockCyclicCholesky::fits(2, true));
+  EXPECT_TRUE(BlockCyclicCholesky::fits(3, true));
+  EXPECT_TRUE(BlockCyclicCholesky::fits(1, false));
+  EXPECT_FALSE(BlockCyclicCholesky::fits(0, false));
 }
 
 }  // namespace

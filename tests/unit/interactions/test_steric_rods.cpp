@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <vector>
 
 #include "curves.hpp"
 #include "interactions/interactions.hpp"
@@ -68,6 +69,28 @@ TEST(StericRods, TwoRodsCellListEqualsDirectAndOracle) {
   StericParams gap = p;
   gap.rods = {{0, half, false, p.ds}, {half + 1, n - half - 1, false, p.ds}};
   EXPECT_THROW(Steric(gap, n), std::invalid_argument);
+}
+
+// steric_rods: the rods the hard core sees, StericParams::rods or one rod of every point
+TEST(StericRods, SegmentsOfTheParamsRodsOrOneRodOfAllPoints) {
+  StericParams p;
+  p.ds = 2.5;
+  p.closed = false;
+  const std::vector<rod::RodRange> one = steric_rods(p, 40);
+  ASSERT_EQ(one.size(), 1u);
+  EXPECT_EQ(one[0].offset, 0);
+  EXPECT_EQ(one[0].n, 40);
+  EXPECT_FALSE(one[0].closed);
+  EXPECT_EQ(one[0].ds, 2.5);
+  p.rods = {{0, 10, true, 3.4}, {10, 30, false, 3.0}};
+  const std::vector<rod::RodRange> two = steric_rods(p, 40);
+  ASSERT_EQ(two.size(), 2u);
+  for (std::size_t r = 0; r < 2; ++r) {
+    EXPECT_EQ(two[r].offset, p.rods[r].offset);
+    EXPECT_EQ(two[r].n, p.rods[r].n);
+    EXPECT_EQ(two[r].closed, p.rods[r].closed);
+    EXPECT_EQ(two[r].ds, p.rods[r].ds);
+  }
 }
 
 }  // namespace

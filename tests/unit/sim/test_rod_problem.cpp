@@ -123,3 +123,31 @@ TEST(RodProblem, TwoRodsOnEachOthersPeriodicImageOverlap) {
   EXPECT_THAT(sim::rods_state_problem(rods, both, box), HasSubstr("in the periodic box"));
   EXPECT_EQ(sim::rods_state_problem(rods, both, 2 * box), "");  // a larger box: apart
 }
+
+// rod_problem and state_problem of one rod of a state laid out by rod::RodRange: points numbered
+// within the rod; an open rod has no link from its last point back to its first.
+TEST(RodProblem, ARodOfAStateByItsRangeAndKind) {
+  const double ds = 3.4;
+  rod::RodState all = ring(ds);  // rod 0: a ring of 10 points; rod 1: 6 points straight along x
+  rod::RodState straight;
+  for (int k = 0; k < 6; ++k) {
+    straight.X.push_back(Vec3(100 + ds * k, 0, 0));
+    Mat3 D;
+    D.col(0) = Vec3(0, 1, 0);
+    D.col(1) = Vec3(0, 0, 1);
+    D.col(2) = Vec3(1, 0, 0);
+    straight.D.push_back(D);
+  }
+  all.X.insert(all.X.end(), straight.X.begin(), straight.X.end());
+  all.D.insert(all.D.end(), straight.D.begin(), straight.D.end());
+  const rod::RodRange ring_range{0, 10, true, ds}, open{10, 6, false, ds}, closed{10, 6, true, ds};
+  EXPECT_EQ(sim::rod_problem(all.X, all.D, ring_range, 0.5), "");
+  EXPECT_EQ(sim::rod_problem(all.X, all.D, open, 0.5), "");
+  // as a ring its closing link is 5 Δs long
+  EXPECT_THAT(sim::rod_problem(all.X, all.D, closed, 0.5), HasSubstr("spacing of points 5 and 0"));
+  EXPECT_EQ(sim::state_problem(straight, open), "");  // the offset is not read
+  EXPECT_THAT(sim::state_problem(straight, closed), HasSubstr("spacing of points 5 and 0"));
+  all.X[10 + 3].x() += 2 * ds;
+  EXPECT_THAT(sim::rod_problem(all.X, all.D, open, 0.5), HasSubstr("spacing of points 2 and 3"));
+  EXPECT_EQ(sim::rod_problem(all.X, all.D, ring_range, 0.5), "");  // rod 0 is untouched
+}
