@@ -74,9 +74,8 @@ void link_jacobians(const Mat3& Dh, const Vec3& xp, double ds, Mat6& JL, Mat6& J
 template <class Fn>
 void for_each_link(const std::vector<rod::RodParams>& rods,
                    const std::vector<rod::RodRange>& ranges, const rod::RodState& s, Fn&& fn) {
-  for (std::size_t r = 0; r < rods.size(); ++r) {
+  rod::for_each_rod(ranges, [&](std::size_t r, const rod::RodRange& g) {
     const rod::RodParams& rp = rods[r];
-    const rod::RodRange& g = ranges[r];
     for (int h = 0; h < rod::links(g); ++h) {
       const int a = g.offset + h, b = g.offset + (h + 1) % g.n;
       Mat6 JL, JR;
@@ -84,7 +83,7 @@ void for_each_link(const std::vector<rod::RodParams>& rods,
                      JR);
       fn(a, b, rp.ds, moduli(rp, h), JL, JR);
     }
-  }
+  });
 }
 
 }  // namespace
