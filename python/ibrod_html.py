@@ -98,9 +98,23 @@ def read_config(run_dir):
         return tomllib.load(f)
 
 
+def rod_layout(cfg, n):
+    """The rods' layout in the frames' n points, [[offset, points, closed], ...]: one per
+    [[rods]] table (its keys over [rod]'s; points = base pairs), or the one rod of [rod]; one rod
+    of all n points, [rod]'s kind, where the tables do not add up to n."""
+    rod = cfg.get("rod", {})
+    layout, offset = [], 0
+    for t in cfg.get("rods") or [{}]:
+        k = int(t.get("base_pairs", rod.get("base_pairs", n)))
+        layout.append([offset, k, bool(t.get("closed", rod.get("closed", True)))])
+        offset += k
+    return layout if offset == n else [[0, n, bool(rod.get("closed", True))]]
+
+
 def run_record(run_dir, max_frames):
-    """The viewer's data of one run: name, ΔLk, Cs, tube diameter, closed, frames (time, Wr, Tw,
-    Lk at the nearest time-series row) and the int16 positions; None without any state."""
+    """The viewer's data of one run: name, ΔLk, Cs, tube diameter, the rods' layout, frames
+    (time, Wr, Tw, Lk at the nearest time-series row) and the int16 positions; None without any
+    state."""
     t, X = read_frames(run_dir, max_frames)
     if t is None:
         return None
@@ -122,7 +136,7 @@ def run_record(run_dir, max_frames):
         "dlk": rod.get("excess_link"),
         "cs": cfg.get("solvent", {}).get("salt_M"),
         "diameter": float(steric.get("diameter_A", 20.0)),
-        "closed": bool(rod.get("closed", True)),
+        "rods": rod_layout(cfg, int(X.shape[1])),
         "n": int(X.shape[1]),
         "frames": frames,
         "pos": base64.b64encode(q.tobytes()).decode("ascii"),
@@ -294,11 +308,12 @@ VIEWER_JS = r"""
     // the tube as overlapping shaded beads of the steric diameter, one per point (and one
     // between neighbours), far ones first so that near ones cover them
     const beads = [];
-    const m = r.closed ? n : n - 1;
     for (let k = 0; k < n; k++) beads.push([P[k][0], P[k][1], P[k][2], k]);
-    for (let k = 0; k < m; k++) {
-      const a = P[k], b = P[(k + 1) % n];
-      beads.push([(a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2, k + 0.5]);
+    for (const [o, nr, closed] of r.rods) {  // each rod's own links: n of a ring, n − 1 if open
+      for (let k = 0; k < (closed ? nr : nr - 1); k++) {
+        const a = P[o + k], b = P[o + (k + 1) % nr];
+        beads.push([(a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2, o + k + 0.5]);
+      }
     }
     beads.sort((u, v) => v[2] - u[2]);
     const rad = Math.max(1.5, r.diameter * scale / 2);

@@ -134,6 +134,27 @@ class HtmlReport(unittest.TestCase):
             shutil.copy(shot, KEEP_SCREENSHOT)
 
 
+class RodLayout(unittest.TestCase):
+    """The viewer's rods (ibrod_html.rod_layout): each [[rods]] table its own links, so that no
+    bead joins one rod's last point to the next rod's first."""
+
+    def test_layout_of_the_rods_tables(self):
+        sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..",
+                                        "python"))
+        from ibrod_html import rod_layout
+
+        two = {"rod": {"base_pairs": 100}, "rods": [{"offset_A": [0, 0, -15]}, {}]}
+        self.assertEqual(rod_layout(two, 200), [[0, 100, True], [100, 100, True]])
+        mixed = {"rod": {"base_pairs": 50, "closed": False},
+                 "rods": [{"closed": True, "base_pairs": 40}, {}]}
+        self.assertEqual(rod_layout(mixed, 90), [[0, 40, True], [40, 50, False]])
+        self.assertEqual(rod_layout({"rod": {"base_pairs": 50, "closed": False}}, 50),
+                         [[0, 50, False]])
+        self.assertEqual(rod_layout({}, 30), [[0, 30, True]])
+        # tables that do not add up to the frames' points: one rod of them all, [rod]'s kind
+        self.assertEqual(rod_layout(two, 150), [[0, 150, True]])
+
+
 if __name__ == "__main__":
     BINARY = sys.argv[1]
     args = sys.argv[2:]
