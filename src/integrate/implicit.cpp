@@ -591,7 +591,39 @@ double ImplicitIntegrator::advance(rod::RodState& s, double max_dt) {
 
 void ImplicitIntegrator::restore(const State& st) {
   ctl_ = AdaptiveDt(ctl_.params(), st.next_dt, st.accepted_in_a_row);
-  stepper_.refresh_jacobian();
+  if (st.held && stepper_.thermal())
+    stepper_.restore_held_filter(*st.held, ctl_.params().dt_max);  // (noise: a fixed Δt)
+  else
+    stepper_.refresh_jacobian();
+}
+
+std::optional<ImplicitStepper::HeldFilter> ImplicitStepper::held_filter() const {
+  // with noise every step ends with K, M_loc and the LU made at its midpoint mid_
+  if (kT_ <= 0 || !have_K_ || lu_dt_ <= 0 || steps_since_jacobian_ == 0) return std::nullopt;
+  return HeldFilter{steps_since_jacobian_, mid_};
+}
+
+void ImplicitStepper::restore_held_filter(const HeldFilter& h, double dt) {
+  if (kT_ <= 0) throw std::logic_error("ImplicitStepper::restore_held_filter: no thermal noise");
+  if (h.at.size() != n_ || h.steps_since_refresh <= 0)
+    throw std::invalid_argument("ImplicitStepper::restore_held_filter: a filter state of " +
+                                std::to_string(h.at.size()) + " points (the rods have " +
+                                std::to_string(n_) + ") or a count of " +
+                                std::to_string(h.steps_since_refresh) + " steps (≥ 1)");
+  // as the thermal step makes them at its midpoint
+  mid_ = h.at;
+  const double t0 = now();
+  use_blocks_ = false;
+  K_ = stiffness(mid_);
+  overlap_at(mid_.X);
+  X_K_ = mid_.X;
+  have_K_ = true;
+  timings_.stiffness += now() - t0;
+  const double t1 = now();
+  factorize(dt);
+  timings_.factorize += now() - t1;
+  ++timings_.factorizations;
+  steps_since_jacobian_ = h.steps_since_refresh % p_.jacobian_every;
 }
 
 }  // namespace ibrod::integrate

@@ -27,6 +27,7 @@
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseLU>
+#include <optional>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -166,8 +167,9 @@ class ImplicitStepper {
   /// was hot"). With the System's thermal_drift, the random finite difference of the spreading
   /// joins the same solve and U, W are interpolated at q̃'s positions. The draws are keyed by
   /// the fluid's seed and noise_step() (set per step by the caller), so a step is a function of
-  /// (qⁿ, Δt, seed, step) and of the filter held (refresh_jacobian() makes it qⁿ's: a resume
-  /// from a periodic checkpoint steps alike).
+  /// (qⁿ, Δt, seed, step) and of the filter held (held_filter(): a checkpoint keeps it and
+  /// restore_held_filter() makes it again, so a resume from a checkpoint at any step steps
+  /// alike).
   /// One implicit step of size dt (s): rod from qⁿ to qⁿ⁺¹. Returns what it did. The forces at
   /// qⁿ⁺¹ are computed here (for energy_after) and kept for the next step, so a step costs one
   /// force evaluation and 1 + krylov_iterations Stokes solves. The potential energies at qⁿ are
@@ -178,6 +180,21 @@ class ImplicitStepper {
   /// The next step refreshes K (a resumed run and the run it continues then step alike: call it
   /// where a checkpoint is written and after one is read).
   void refresh_jacobian() { steps_since_jacobian_ = 0; }
+
+  /// With thermal noise, what of the past a step depends on besides qⁿ: the state its
+  /// predictor's filter was made at (the previous step's midpoint q̃) and the steps since K was
+  /// last made at a step's start (p.jacobian_every counts them).
+  struct HeldFilter {
+    long steps_since_refresh = 0;
+    rod::RodState at;
+  };
+  /// The held filter (thermal noise only; empty without noise, before the first step and when
+  /// the next step makes the filter at qⁿ anyway). A checkpoint keeps it, so that a run stopped
+  /// at any step (a signal) and resumed steps bitwise as the uninterrupted one.
+  std::optional<HeldFilter> held_filter() const;
+  /// Makes the held filter again at h.at (K, M_loc and their LU for a step of dt, s) and sets
+  /// the count: the next step then takes the bits of the one that followed held_filter().
+  void restore_held_filter(const HeldFilter& h, double dt);
 
   /// (U, W) = M (F, T) at positions X: one Stokes solve (MODEL §4 spreading and interpolation,
   /// ρ dropped). Å s⁻¹, s⁻¹.
@@ -293,6 +310,9 @@ class ImplicitIntegrator final : public Scheme {
   struct State {
     double next_dt = 0;  ///< s
     int accepted_in_a_row = 0;
+    /// with thermal noise: the filter the next step's predictor uses (ImplicitStepper::
+    /// held_filter; empty: made afresh at qⁿ)
+    std::optional<ImplicitStepper::HeldFilter> held;
   };
   ImplicitIntegrator(System& system, const ImplicitParams& p, const AdaptiveDtParams& a);
 
@@ -305,9 +325,16 @@ class ImplicitIntegrator final : public Scheme {
   int last_rejections() const { return rejected_; }
   long rejections() const { return ctl_.rejections(); }
 
-  State state() const { return {ctl_.dt(), ctl_.accepted_in_a_row()}; }
+  State state() const { return {ctl_.dt(), ctl_.accepted_in_a_row(), stepper_.held_filter()}; }
+  /// Puts st back: the controller, and with noise the held filter (made again where st says;
+  /// without it, or without noise, K is refreshed at the next step).
   void restore(const State& st);
   void refresh() override { stepper_.refresh_jacobian(); }
+  /// Without noise K is refreshed where a checkpoint is written (the resumed run refreshes it
+  /// too); with noise nothing changes: the checkpoint keeps the held filter (state()).
+  void checkpoint_taken() override {
+    if (!stepper_.thermal()) refresh();
+  }
   double power() const override { return stepper_.power(); }
   ImplicitStepper& stepper() { return stepper_; }
   const ImplicitStepper& stepper() const { return stepper_; }

@@ -206,6 +206,10 @@ class Scheme {
   /// The next step starts afresh from the state (a checkpoint written or read, a state set):
   /// what a scheme keeps between steps from the state (the implicit stiffness) is rebuilt.
   virtual void refresh() {}
+  /// A checkpoint of the state was just taken: what the scheme keeps between steps is either in
+  /// the checkpoint or refreshed here (the default), so that the run and its resumption step
+  /// alike.
+  virtual void checkpoint_taken() { refresh(); }
   /// The power of the rods' loads in the latest step, Σ_k F_k·U_k + T_k·W_k (g Å² s⁻³), with
   /// the forces and torques the step moved the rods by and the velocities it moved them with:
   /// the rate −dE_pot/dt at which the potential energy goes into the fluid (the dissipation

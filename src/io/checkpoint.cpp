@@ -69,6 +69,10 @@ std::string meta_json(const CheckpointMeta& m) {
   j["stability_tests"] = nlohmann::json::parse(m.stability_tests_json);
   j["implicit_next_dt_s"] = m.implicit_next_dt_s;
   j["implicit_accepted_in_a_row"] = m.implicit_accepted_in_a_row;
+  if (!m.implicit_filter_X.empty())
+    j["implicit_filter"] = {{"steps_since_refresh", m.implicit_filter_steps},
+                            {"X", m.implicit_filter_X},
+                            {"D", m.implicit_filter_D}};
   j["initial"] = observables_json(m.initial);
   j["config_toml"] = m.config_toml;
   return j.dump();  // doubles with 17 significant digits: they read back exactly
@@ -92,6 +96,17 @@ CheckpointMeta meta_from(const std::string& text) {
   if (j.contains("implicit_next_dt_s")) {
     m.implicit_next_dt_s = j.at("implicit_next_dt_s").get<double>();
     m.implicit_accepted_in_a_row = j.at("implicit_accepted_in_a_row").get<int>();
+  }
+  // absent without thermal noise and in checkpoints from before it was kept
+  if (j.contains("implicit_filter")) {
+    const auto& f = j.at("implicit_filter");
+    m.implicit_filter_steps = f.at("steps_since_refresh").get<std::int64_t>();
+    m.implicit_filter_X = f.at("X").get<std::vector<double>>();
+    m.implicit_filter_D = f.at("D").get<std::vector<double>>();
+    if (m.implicit_filter_X.size() % 3 != 0 ||
+        m.implicit_filter_D.size() != 3 * m.implicit_filter_X.size() ||
+        m.implicit_filter_steps < 1)
+      throw std::invalid_argument("its implicit_filter's X, D and steps_since_refresh do not fit");
   }
   m.initial = observables_from(j.at("initial"));
   m.config_toml = j.at("config_toml").get<std::string>();
@@ -225,6 +240,8 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
     ck.meta = meta_from(json);
   } catch (const nlohmann::json::exception& e) {
     throw ConfigError("checkpoint " + name + " has unreadable metadata: " + e.what());
+  } catch (const std::invalid_argument& e) {
+    throw ConfigError("checkpoint " + name + " is inconsistent: " + e.what());
   }
   const auto n = r.get_value<std::int64_t>();
   if (n < 0 || std::uint64_t(n) > r.left / (12 * sizeof(double)))
@@ -233,6 +250,10 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
   ck.rod.D.resize(std::size_t(n));
   for (Vec3& x : ck.rod.X) r.get(x.data(), 3 * sizeof(double));
   for (Mat3& d : ck.rod.D) r.get(d.data(), 9 * sizeof(double));
+  if (!ck.meta.implicit_filter_X.empty() && ck.meta.implicit_filter_X.size() != 3 * std::size_t(n))
+    throw ConfigError("checkpoint " + name + " is inconsistent: its implicit_filter has " +
+                      std::to_string(ck.meta.implicit_filter_X.size() / 3) + " points, the rods " +
+                      std::to_string(n));
   const auto gn = r.get_value<std::int64_t>();
   if (gn < 1 || gn > 1 << 14)
     throw ConfigError("checkpoint " + name + " is inconsistent: bad grid size " +
@@ -262,6 +283,15 @@ void record_state(CheckpointMeta& meta, const sim::Snapshot& s) {
   meta.time_s = s.time;
   meta.implicit_next_dt_s = s.implicit.next_dt > 0 ? s.implicit.next_dt : -1.0;
   meta.implicit_accepted_in_a_row = s.implicit.next_dt > 0 ? s.implicit.accepted_in_a_row : 0;
+  meta.implicit_filter_steps = 0;
+  meta.implicit_filter_X.clear();
+  meta.implicit_filter_D.clear();
+  if (s.implicit.next_dt > 0 && s.implicit.held) {
+    const rod::RodState& q = s.implicit.held->at;
+    meta.implicit_filter_steps = s.implicit.held->steps_since_refresh;
+    for (const Vec3& x : q.X) meta.implicit_filter_X.insert(meta.implicit_filter_X.end(), x.data(), x.data() + 3);
+    for (const Mat3& d : q.D) meta.implicit_filter_D.insert(meta.implicit_filter_D.end(), d.data(), d.data() + 9);
+  }
 }
 
 sim::Snapshot snapshot_of(Checkpoint&& ck, double dt) {
@@ -271,7 +301,19 @@ sim::Snapshot snapshot_of(Checkpoint&& ck, double dt) {
   s.step = ck.meta.step;
   // checkpoints from before time was state: step × Δt of the run that wrote them
   s.time = ck.meta.time_s >= 0 ? ck.meta.time_s : double(ck.meta.step) * dt;
-  s.implicit = {ck.meta.implicit_next_dt_s, ck.meta.implicit_accepted_in_a_row};
+  s.implicit = {ck.meta.implicit_next_dt_s, ck.meta.implicit_accepted_in_a_row, std::nullopt};
+  if (!ck.meta.implicit_filter_X.empty()) {
+    integrate::ImplicitStepper::HeldFilter h;
+    h.steps_since_refresh = long(ck.meta.implicit_filter_steps);
+    const std::size_t n = ck.meta.implicit_filter_X.size() / 3;
+    h.at.X.resize(n);
+    h.at.D.resize(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      std::copy_n(ck.meta.implicit_filter_X.data() + 3 * k, 3, h.at.X[k].data());
+      std::copy_n(ck.meta.implicit_filter_D.data() + 9 * k, 9, h.at.D[k].data());
+    }
+    s.implicit.held = std::move(h);
+  }
   return s;
 }
 

@@ -49,6 +49,12 @@ struct CheckpointMeta {
   /// accepted steps (sim::Simulation::implicit_state)
   double implicit_next_dt_s = -1;
   int implicit_accepted_in_a_row = 0;
+  /// time.scheme = "implicit" with solvent.thermal: the state the next step's predictor filter is
+  /// made at (ImplicitStepper::held_filter: X in Å, 3 per point, and D, 9 per point in the rod
+  /// block's order) and the steps since K was made at a step's start; an empty X: none (made
+  /// afresh at the resumed state, as in checkpoints written before it was kept)
+  std::int64_t implicit_filter_steps = 0;
+  std::vector<double> implicit_filter_X, implicit_filter_D;
 };
 
 struct Checkpoint {

@@ -117,7 +117,7 @@ struct Snapshot {
   double time = 0;  ///< simulated time, s
   /// time.scheme = "implicit": the step controller's next Δt and run of accepted steps;
   /// next_dt ≤ 0 for the explicit scheme (none)
-  integrate::ImplicitIntegrator::State implicit{-1, 0};
+  integrate::ImplicitIntegrator::State implicit{-1, 0, std::nullopt};
 };
 
 /// Why a run stopped (summary.json's stop_reason, the checkpoint's): none while it runs.
@@ -181,7 +181,7 @@ class Simulation {
   /// To be called where a checkpoint is written, so that the run and its resumption refresh the
   /// implicit scheme's stiffness at the same step (resume stays bitwise). No-op for the explicit
   /// scheme.
-  void checkpoint_taken() { scheme_->refresh(); }
+  void checkpoint_taken() { scheme_->checkpoint_taken(); }
   /// Moves the end of the time (t_end, s; > 0): a run continued in segments (the Python module's
   /// `run(steps=…)`, driver::Run::set_end_time). Throws std::invalid_argument if not positive.
   void set_t_end(double t_end);

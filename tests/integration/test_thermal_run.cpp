@@ -101,7 +101,8 @@ TEST(ThermalRun, SameSeedSameBitsAcrossAResumeAndRoundOffAcrossThreads) {
 // The implicit scheme with noise (issue 28, docs/thermal.md "The implicit step with noise"):
 // the overlap M_loc, order 1, a fixed Δt. 100 steps of 0.25 ns: the same seed gives the same
 // bits, half the run extended from its checkpoint (K and M_loc refreshed there in both runs)
-// ends bitwise where the uninterrupted one does, another seed elsewhere. About a second a run.
+// ends bitwise where the uninterrupted one does, and so does one stopped between checkpoints
+// (the checkpoint keeps the held filter's state), another seed elsewhere. About a second a run.
 std::string implicit_thermal_config(int seed) {
   config::Config c = small_config(2);
   c.time_scheme = "implicit";
@@ -133,6 +134,16 @@ TEST(ThermalRun, ImplicitSameSeedSameBitsAcrossAResume) {
       run_ibrod({"run", "--resume", c.string(), "--set", "time.t_end_us=0.025"}, root / "C2.log");
   ASSERT_EQ(e.code, 0) << e.output;
   EXPECT_EQ(read_file(a / "final_state.csv"), read_file(c / "final_state.csv"));
+  // stopped between checkpoints (step 37, as a signal stops a run: its checkpoint is written
+  // there, off the schedule of 50): the checkpoint keeps the state the held filter was made at,
+  // so the resumed run still ends on A's bits (with the filter made afresh there it did not)
+  const fs::path g =
+      run_config(root, "G", implicit_thermal_config(5), {"--set", "time.t_end_us=0.00925"});
+  const Exit eg =
+      run_ibrod({"run", "--resume", g.string(), "--set", "time.t_end_us=0.025"}, root / "G2.log");
+  ASSERT_EQ(eg.code, 0) << eg.output;
+  EXPECT_EQ(read_file(a / "final_state.csv"), read_file(g / "final_state.csv"));
+  EXPECT_EQ(read_file(a / "timeseries.csv"), read_file(g / "timeseries.csv"));
   const fs::path d = run_config(root, "D", implicit_thermal_config(6));
   EXPECT_NE(read_file(a / "final_state.csv"), read_file(d / "final_state.csv"));
   // the noise moves the ring: the final state is not the deterministic one

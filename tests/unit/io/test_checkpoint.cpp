@@ -109,6 +109,54 @@ TEST(Checkpoint, RoundTripIsExact) {
   fs::remove_all(d);
 }
 
+// The implicit thermal scheme's held filter (issue 28: a run stopped by a signal at any step
+// resumes bitwise): the state it was made at goes through record_state, the JSON and
+// snapshot_of exactly; none stays none; a filter of another size than the rods is refused.
+TEST(Checkpoint, TheHeldFilterStateRoundTripsExactly) {
+  const fs::path d = scratch("held");
+  Fixture f;
+  sim::Snapshot s;
+  s.rod = f.rod;
+  s.step = 1234;
+  s.time = 3.1e-7;
+  s.implicit.next_dt = 1e-9;
+  s.implicit.accepted_in_a_row = 4;
+  integrate::ImplicitStepper::HeldFilter h;
+  h.steps_since_refresh = 17;
+  h.at = f.rod;
+  for (int k = 0; k < h.at.size(); ++k) {
+    h.at.X[k] += Vec3(1.0 / 3.0, -std::sqrt(3.0), 1e-17 * k);
+    h.at.D[k] = rotation(Vec3(0.01 * std::sqrt(double(k)), -0.2, 0.1)) * h.at.D[k];
+  }
+  s.implicit.held = h;
+  io::record_state(f.meta, s);
+  f.write(d / "c.bin");
+  io::Checkpoint c = io::read_checkpoint(d / "c.bin");
+  const sim::Snapshot back = io::snapshot_of(std::move(c), 1e-9);
+  ASSERT_TRUE(back.implicit.held.has_value());
+  EXPECT_EQ(back.implicit.held->steps_since_refresh, 17);
+  ASSERT_EQ(back.implicit.held->at.size(), 5);
+  for (int k = 0; k < 5; ++k) {
+    EXPECT_EQ(back.implicit.held->at.X[k], h.at.X[k]);  // bitwise, through JSON
+    EXPECT_EQ(back.implicit.held->at.D[k], h.at.D[k]);
+  }
+  EXPECT_EQ(back.implicit.next_dt, 1e-9);
+  EXPECT_EQ(back.implicit.accepted_in_a_row, 4);
+  // none: no key, none back
+  s.implicit.held.reset();
+  io::record_state(f.meta, s);
+  f.write(d / "c.bin");
+  EXPECT_FALSE(io::snapshot_of(io::read_checkpoint(d / "c.bin"), 1e-9).implicit.held);
+  // a filter of 4 points beside a rod of 5
+  h.at.X.pop_back();
+  h.at.D.pop_back();
+  s.implicit.held = h;
+  io::record_state(f.meta, s);
+  f.write(d / "c.bin");
+  EXPECT_THAT(read_error(d / "c.bin"), HasSubstr("implicit_filter has 4 points, the rods 5"));
+  fs::remove_all(d);
+}
+
 TEST(Checkpoint, TruncatedFilesAreRejected) {
   const fs::path d = scratch("truncated");
   Fixture().write(d / "c.bin");
