@@ -385,6 +385,8 @@ sim::SimParams to_params(const Config& c) {
   p.implicit.order = c.time_implicit_order;
   p.adaptive.error_tolerance =
       c.time_implicit_order == 2 ? c.time_error_tolerance_A * angstrom : 0.0;
+  p.implicit.krylov_error_budget =
+      c.time_implicit_krylov_error_share * p.adaptive.error_tolerance;
   return p;
 }
 

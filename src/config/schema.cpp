@@ -422,7 +422,8 @@ const std::vector<Key>& schema() {
               1, 1000000,
               "implicit, time.implicit_local_mobility = \"overlap\": steps between refreshes of "
               "M_loc, the stiffness and their LU (which costs ~10 Stokes solves at the "
-              "reference; > 1: a run resumed after a signal is not bitwise the same)"),
+              "reference; > 1: a run resumed after a signal is not bitwise the same, except with "
+              "solvent.thermal, whose checkpoint keeps the filter)"),
       real("time.implicit_refresh_displacement_A", &Config::time_implicit_refresh_displacement_A, 0,
            false, 1e4,
            "implicit: also refresh the stiffness, M_loc and their factorisation before their "
@@ -438,6 +439,10 @@ const std::vector<Key>& schema() {
       real("time.implicit_krylov_tol", &Config::time_implicit_krylov_tol, 0, true, 1,
            "implicit: relative residual at which GMRES stops (order 1: not reached, the step is "
            "retried shorter; order 2: the step stands, its error estimate judges it)"),
+      real("time.implicit_krylov_error_share", &Config::time_implicit_krylov_error_share, 0, false,
+           1, "implicit, order 2 with GMRES and error control: GMRES also stops once a stage's "
+           "residual moves the step by at most this share of time.error_tolerance_A "
+           "(Δt ‖r‖ ≤ share × tolerance; docs/large_dt.md §13) (0: time.implicit_krylov_tol alone)"),
       integer("time.implicit_order", &Config::time_implicit_order, 1, 2,
               "implicit: 1 (the linearly implicit IMEX Euler step, one Stokes solve a step; the "
               "default) or 2 (two-stage Rosenbrock-W, ROS2: second order, an error estimate and "

@@ -346,8 +346,13 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
           return x + wdt * apply_mobility(K_ * x);
         };
         double res = 0;
+        double tol = p_.krylov_tol;
+        if (p_.krylov_error_budget > 0) {
+          const double bnorm = std::sqrt(dot(rhs, rhs));
+          if (bnorm > 0) tol = std::max(tol, p_.krylov_error_budget / (dt * bnorm));
+        }
         info.krylov_iterations +=
-            gmres(apply, precondition, rhs, k, p_.krylov_max_iter, p_.krylov_tol, dot, res);
+            gmres(apply, precondition, rhs, k, p_.krylov_max_iter, tol, dot, res);
         info.residual = std::max(info.residual, res);
       }
       return k;

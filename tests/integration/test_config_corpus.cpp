@@ -207,7 +207,8 @@ std::vector<Case> generated() {
                            "time.implicit_overlap_scale",
                            "time.implicit_jacobian_every",
                            "time.implicit_krylov_iterations",
-                           "time.implicit_krylov_tol"};
+                           "time.implicit_krylov_tol",
+                           "time.implicit_krylov_error_share"};
   const char* boolean[] = {"solvent.advection", "electrostatics.enabled", "steric.enabled",
                            "output.fluid_vti",  "output.fluid_velocity",  "run.fftw_measure"};
   std::vector<Case> out;

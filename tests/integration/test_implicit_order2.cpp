@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "config/config.hpp"
+#include "core/units.hpp"
 #include "helpers.hpp"
 #include "integrate/implicit.hpp"
 #include "rod/rod.hpp"
@@ -26,7 +27,7 @@ struct Ring {
   std::unique_ptr<integrate::ImplicitStepper> imp;
   explicit Ring(double beta, int order = 1, int excess_link = 3,
                 std::vector<double> perturbation = {1.0}, int krylov = 0, double tol = 1e-2,
-                bool overlap = false) {
+                bool overlap = false, double krylov_error_budget = 0.0) {
     config::Config c = test::small_config(excess_link);
     c.run_threads = 1;
     c.rod_perturbation = perturbation;
@@ -38,6 +39,7 @@ struct Ring {
     ip.order = order;
     ip.krylov_max_iter = krylov;  // order 2: GMRES on the true W = I + γΔt M K per stage
     ip.krylov_tol = tol;
+    ip.krylov_error_budget = krylov_error_budget;  // Å: GMRES stops once Δt ‖r‖ ≤ this
     if (overlap) ip.local_mobility = integrate::ImplicitParams::LocalMobility::overlap;
     imp = std::make_unique<integrate::ImplicitStepper>(*st, ip);
   }
@@ -296,6 +298,43 @@ TEST(ImplicitOrder2, TrueMobilityStagesLeaveTheFluidOfTheLoadsNotOfAKrylovDirect
     EXPECT_EQ(oa.E_kinetic_kT, ob.E_kinetic_kT) << order;
     EXPECT_EQ(oa.E_total_kT, ob.E_total_kT) << order;
   }
+}
+
+}  // namespace
+}  // namespace ibrod
+
+namespace ibrod {
+namespace {
+
+// time.implicit_krylov_error_share: a stage's GMRES also stops once its residual moves the step
+// by at most a budget, Δt ‖r‖ ≤ b (docs/large_dt.md §13). One step of 1 ns of the ΔLk = 3 ring
+// from the same state with the stages solved to 1e-12 and with budgets of 1e-6 … 100 Å: the step
+// must land within the budget's reach of the converged one — a residual r leaves an error W⁻¹ r
+// in a stage, the step moves Δt (3/2 e₁ + 1/2 e₂), so at most ~2 b with |W⁻¹| ≤ 1; measured
+// 0.02–0.05 b, the norm being over all 6n components and the distance the largest point's — and GMRES
+// must do fewer products the larger the budget, none (two Stokes solves for the loads and one
+// residual a stage) once the local solve's guess is inside it.
+TEST(ImplicitOrder2, AnErrorBudgetStopsTheStagesGmresWithinItsShareOfTheMove) {
+  const double dt = 1e-9;
+  Ring tight(1.0, 2, 3, {1.0}, 60, 1e-12, true);
+  const integrate::ImplicitStepInfo ref = tight.imp->step(tight.rod, dt);
+  EXPECT_LE(ref.residual, 1e-12);
+  int last = ref.krylov_iterations;
+  for (const double b : {1e-6, 1e-5, 1e-4, 1e-3, 1e-2, 1.0, 100.0}) {
+    Ring r(1.0, 2, 3, {1.0}, 60, 1e-12, true, b * units::angstrom);
+    const integrate::ImplicitStepInfo info = r.imp->step(r.rod, dt);
+    const double d = max_distance(r.rod, tight.rod);
+    std::printf("  budget %.0e A: %d GMRES iterations (converged: %d), %d Stokes solves, step %.3e A "
+                "from the converged one, move %.3e A\n",
+                b, info.krylov_iterations, ref.krylov_iterations, info.fluid_solves, d,
+                info.max_displacement);
+    EXPECT_LE(d, 2.0 * b) << b;
+    EXPECT_LE(info.krylov_iterations, last) << b;
+    EXPECT_EQ(info.fluid_solves, 4 + info.krylov_iterations) << b;
+    last = info.krylov_iterations;
+  }
+  EXPECT_LT(last, ref.krylov_iterations);
+  EXPECT_EQ(last, 0);  // 100 Å: the guess W_loc⁻¹ rhs is inside the budget on both stages
 }
 
 }  // namespace

@@ -3,6 +3,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <string>
+
 #include "config/config.hpp"
 #include "core/error.hpp"
 
@@ -123,6 +125,22 @@ TEST(SchemeKeys, OrderTwoAndItsErrorToleranceReachTheParameters) {
   EXPECT_EQ(p.implicit.order, 2);
   EXPECT_EQ(p.implicit.krylov_max_iter, 3);
   EXPECT_DOUBLE_EQ(p.adaptive.error_tolerance, 0.05);
+  EXPECT_EQ(p.implicit.krylov_error_budget, 0.0);  // off by default
+  // the GMRES residual's share of the error tolerance (docs/large_dt.md §13): a length, Å
+  config::apply_override(c, "time.implicit_krylov_error_share=0.3");
+  EXPECT_DOUBLE_EQ(config::to_params(c).implicit.krylov_error_budget, 0.3 * 0.05);
+  config::apply_override(c, "time.implicit_order=1");  // no error control, no budget
+  EXPECT_EQ(config::to_params(c).implicit.krylov_error_budget, 0.0);
+  config::apply_override(c, "time.implicit_order=2");
+  for (const char* bad : {"-0.1", "1.5", "nan"}) {
+    try {
+      config::apply_override(c, std::string("time.implicit_krylov_error_share=") + bad);
+      FAIL() << "accepted " << bad;
+    } catch (const ConfigError& e) {
+      EXPECT_THAT(e.what(), HasSubstr("time.implicit_krylov_error_share")) << bad;
+    }
+  }
+  EXPECT_THAT(config::describe(c), HasSubstr("time.implicit_krylov_error_share"));
   config::apply_override(c, "time.implicit_krylov_iterations=0");
   EXPECT_THROW(config::apply_override(c, "time.implicit_order=3"), std::exception);
 }
