@@ -57,7 +57,7 @@ struct Config {
   int time_implicit_krylov_iterations = 0;  ///< implicit: GMRES iterations (0: IMEX)
   double time_implicit_krylov_tol = 1e-2;   ///< implicit: GMRES relative residual
   /// implicit, order 2 with GMRES: the share of time.error_tolerance_A that a stage's residual
-  /// may take of the step's move, Δt ‖r‖ (0: the relative residual alone)
+  /// may move the rod's points by, in RMS: Δt ‖r‖/√n (0: the relative residual alone)
   double time_implicit_krylov_error_share = 0.0;
   int time_implicit_order = 1;              ///< implicit: 1 (IMEX Euler) or 2 (ROS2), issue 24
   double time_error_tolerance_A = 0.1;  ///< implicit, order 2: local error per step, Å (0: off)

@@ -441,8 +441,9 @@ const std::vector<Key>& schema() {
            "retried shorter; order 2: the step stands, its error estimate judges it)"),
       real("time.implicit_krylov_error_share", &Config::time_implicit_krylov_error_share, 0, false,
            1, "implicit, order 2 with GMRES and error control: GMRES also stops once a stage's "
-           "residual moves the step by at most this share of time.error_tolerance_A "
-           "(Δt ‖r‖ ≤ share × tolerance; docs/large_dt.md §13) (0: time.implicit_krylov_tol alone)"),
+           "residual moves the rod's points by at most this share of time.error_tolerance_A in "
+           "RMS (Δt ‖r‖/√n ≤ share × tolerance; docs/large_dt.md §13) (0: "
+           "time.implicit_krylov_tol alone)"),
       integer("time.implicit_order", &Config::time_implicit_order, 1, 2,
               "implicit: 1 (the linearly implicit IMEX Euler step, one Stokes solve a step; the "
               "default) or 2 (two-stage Rosenbrock-W, ROS2: second order, an error estimate and "

@@ -349,7 +349,9 @@ ImplicitStepInfo ImplicitStepper::step(rod::RodState& s, double dt) {
         double tol = p_.krylov_tol;
         if (p_.krylov_error_budget > 0) {
           const double bnorm = std::sqrt(dot(rhs, rhs));
-          if (bnorm > 0) tol = std::max(tol, p_.krylov_error_budget / (dt * bnorm));
+          // Δt ‖r‖/√n: the residual's move of the rod's points in RMS
+          if (bnorm > 0)
+            tol = std::max(tol, p_.krylov_error_budget * std::sqrt(double(n)) / (dt * bnorm));
         }
         info.krylov_iterations +=
             gmres(apply, precondition, rhs, k, p_.krylov_max_iter, tol, dot, res);

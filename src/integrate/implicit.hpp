@@ -47,11 +47,12 @@ struct ImplicitParams {
   /// relative residual at which GMRES stops; order 1: a step that does not reach it is
   /// rejected (converged = false); order 2: it stands, judged by its error estimate
   double krylov_tol = 1e-2;
-  /// order 2 with GMRES: a stage's GMRES also stops once Δt ‖r‖ ≤ this (length, the units of
-  /// the positions; ‖·‖ the mobility-balanced norm of the velocities): the residual's share of
-  /// the step's move (a residual r leaves an error W⁻¹r in the stage, |W⁻¹| ≤ 1 on the stiff
-  /// modes). Where the ring moves little (near rest) a relative residual of krylov_tol asks for
-  /// far more than the error control can see (docs/large_dt.md §13). 0: krylov_tol alone
+  /// order 2 with GMRES: a stage's GMRES also stops once Δt ‖r‖/√n ≤ this (length, the units
+  /// of the positions; ‖·‖ GMRES's mobility-balanced norm of the velocities, over all n points:
+  /// the residual's move of the points in RMS). A residual r leaves an error W⁻¹r in the stage
+  /// (|W⁻¹| ≤ 1 on the stiff modes); where the ring moves little a relative residual of
+  /// krylov_tol asks for far more than the error control can see (docs/large_dt.md §13).
+  /// 0: krylov_tol alone
   double krylov_error_budget = 0.0;
   /// trial steps between refreshes of K and of its factorisation (≥ 1; K at qⁿ when refreshed,
   /// and whenever Δt changes). 1: K is a function of the state alone, so a run resumed from any

@@ -306,14 +306,14 @@ TEST(ImplicitOrder2, TrueMobilityStagesLeaveTheFluidOfTheLoadsNotOfAKrylovDirect
 namespace ibrod {
 namespace {
 
-// time.implicit_krylov_error_share: a stage's GMRES also stops once its residual moves the step
-// by at most a budget, Δt ‖r‖ ≤ b (docs/large_dt.md §13). One step of 1 ns of the ΔLk = 3 ring
-// from the same state with the stages solved to 1e-12 and with budgets of 1e-6 … 100 Å: the step
-// must land within the budget's reach of the converged one — a residual r leaves an error W⁻¹ r
-// in a stage, the step moves Δt (3/2 e₁ + 1/2 e₂), so at most ~2 b with |W⁻¹| ≤ 1; measured
-// 0.02–0.05 b, the norm being over all 6n components and the distance the largest point's — and GMRES
-// must do fewer products the larger the budget, none (two Stokes solves for the loads and one
-// residual a stage) once the local solve's guess is inside it.
+// time.implicit_krylov_error_share: a stage's GMRES also stops once its residual moves the rod's
+// points by at most a budget in RMS, Δt ‖r‖/√n ≤ b (docs/large_dt.md §13). One step of 1 ns of
+// the ΔLk = 3 ring from the same state with the stages solved to 1e-12 and with budgets of
+// 1e-6 … 100 Å: a residual r leaves an error W⁻¹ r in a stage (|W⁻¹| ≤ 1 on the stiff modes) and
+// the step moves Δt (3/2 e₁ + 1/2 e₂), so the points move off the converged step by ~2b in RMS;
+// the largest point's distance, measured 0.14–0.40 b, must stay within 2b. And GMRES must do
+// fewer products the larger the budget, none (two Stokes solves for the loads and one residual a
+// stage) once the local solve's guess is inside it.
 TEST(ImplicitOrder2, AnErrorBudgetStopsTheStagesGmresWithinItsShareOfTheMove) {
   const double dt = 1e-9;
   Ring tight(1.0, 2, 3, {1.0}, 60, 1e-12, true);
