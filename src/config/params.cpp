@@ -354,6 +354,17 @@ sim::SimParams to_params(const Config& c) {
   p.stability.time = c.time_stability_probe_us * us;
   p.stability.tolerance = c.time_stability_tolerance_kT * p.kT;
   p.stability.seed = std::uint64_t(c.time_stability_seed);
+  p.stability.method = c.time_stability_method == "hessian" ? sim::StabilityProbe::Method::hessian
+                                                            : sim::StabilityProbe::Method::dynamic;
+  if (c.time_stability_test && p.stability.method == sim::StabilityProbe::Method::hessian) {
+    int points = 0;
+    for (const rod::RodParams& r : s.rods) points += r.n;
+    if (points > sim::StabilityProbe::kMaxHessianPoints)
+      bad("time.stability_method", "\"hessian\"",
+          "\"dynamic\" for more than " + std::to_string(sim::StabilityProbe::kMaxHessianPoints) +
+              " rod points (the run has " + std::to_string(points) +
+              "): the Hessian is dense, 6 unknowns a point, and its eigenvalues cost O((6n)³)");
+  }
   p.output.rows = c.output_every_steps;
   p.output.frames = frame_every(c);
   p.output.checkpoints = c.output_checkpoint_every_steps;

@@ -213,6 +213,29 @@ Key scheme_key() {
   return k;
 }
 
+// time.stability_method: "dynamic" or "hessian" (the stability test, docs/config.md)
+Key stability_method_key() {
+  Key k;
+  k.name = "time.stability_method";
+  k.help =
+      "how the stability test decides: \"dynamic\" (integrate a kicked copy and the "
+      "unperturbed one for time.stability_probe_us and compare their energies) or \"hessian\" "
+      "(the lowest eigenvalue of the total energy's Hessian, less the rigid-body modes: "
+      "unstable if a kick of time.stability_kick_A along its mode lowers the energy by more "
+      "than time.stability_tolerance_kT; dense, at most 1500 points; docs/config.md)";
+  k.set = [](Config& c, const toml::node& n) {
+    const auto v = n.value_exact<std::string>();
+    if (!v || (*v != "dynamic" && *v != "hessian"))
+      bad("time.stability_method", show(n), "\"dynamic\" or \"hessian\"");
+    c.time_stability_method = *v;
+  };
+  k.put = [](const Config& c, toml::table& t) {
+    t.insert_or_assign("stability_method", c.time_stability_method);
+  };
+  k.value = [](const Config& c) { return "\"" + c.time_stability_method + "\""; };
+  return k;
+}
+
 // time.implicit_local_mobility: "self" or "overlap" (issue 24)
 Key local_mobility_key() {
   Key k;
@@ -396,13 +419,15 @@ const std::vector<Key>& schema() {
       real("time.stability_kick_A", &Config::time_stability_kick_A, 0, true, 100.0,
            "out-of-plane amplitude of the stability test's kick of the positions, Å"),
       real("time.stability_probe_us", &Config::time_stability_probe_us, 0, true, 1e3,
-           "how long the stability test integrates the kicked copy and the unperturbed one, µs"),
+           "how long the stability test integrates the kicked copy and the unperturbed one, µs "
+           "(\"hessian\": after k unstable verdicts in a row the next test waits 2^(k-1) × this)"),
       real("time.stability_tolerance_kT", &Config::time_stability_tolerance_kT, 0, false, 1e6,
            "how far the kicked copy's energy must end below the unperturbed one's to call the "
            "state unstable, kT"),
       integer("time.stability_seed", &Config::time_stability_seed, 0,
               std::numeric_limits<std::int64_t>::max(),
               "seed of the stability test's perturbation"),
+      stability_method_key(),
       scheme_key(),
       real("time.max_displacement_A", &Config::time_max_displacement_A, 0, false, 1e4,
            "implicit: largest move of a rod point in one step, Å; a longer step is retried "

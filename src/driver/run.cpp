@@ -303,6 +303,19 @@ StopReason Run::State::test_stability(StopReason candidate) {
   const sim::StabilityProbe& probe = s.params().stability;
   if (!probe.enabled || distributed) return candidate;
   nlohmann::json tests = nlohmann::json::parse(meta.stability_tests_json);
+  if (probe.method == sim::StabilityProbe::Method::hessian) {
+    // The Hessian test takes no simulated time, and after an unstable verdict a slow unstable
+    // mode (the ΔLk = 2 circle: tens of µs) keeps the rule firing at every output step while the
+    // state has barely moved. So after k unstable verdicts in a row the next test waits until
+    // 2^(k−1) time.stability_probe_us have passed since the last (read from the tests listed,
+    // which the checkpoint keeps: a resumed run tests at the same steps).
+    int k = 0;
+    double last_us = 0;
+    for (auto it = tests.rbegin(); it != tests.rend() && !(*it).value("stable", true); ++it)
+      if (k++ == 0) last_us = (*it).value("time_us", 0.0);
+    if (k > 0 && s.time() / 1e-6 < last_us + std::ldexp(probe.time / 1e-6, k - 1))
+      return s.at_end() ? StopReason::end_time : StopReason::none;
+  }
   const sim::ProbeOutcome o = sim::probe_stability(s, probe, tests.size());
   tests.push_back({{"step", o.step},
                    {"time_us", o.time_us},
@@ -321,7 +334,16 @@ StopReason Run::State::test_stability(StopReason candidate) {
                    {"writhe_before", o.writhe_before},
                    {"writhe_continuation", o.writhe_continuation},
                    {"writhe_after", o.writhe_after},
-                   {"stable", o.stable}});
+                   {"stable", o.stable},
+                   {"method", o.hessian ? "hessian" : "dynamic"}});
+  if (o.hessian) {
+    nlohmann::json& t = tests.back();
+    t["lowest_eigenvalues_kT_per_A2"] = o.lowest_eigenvalues;
+    t["negative_modes"] = o.negative_modes;
+    t["zero_modes"] = o.zero_modes;
+    t["gradient_kT_per_A"] = o.gradient_kT_per_A;
+    t["hessian_asymmetry"] = o.asymmetry;
+  }
   meta.stability_tests_json = tests.dump();
   say("ibrod: stability test at step " + std::to_string(o.step) + ": " + sim::describe(o) +
       (o.stable ? "; an equilibrium" : "; not an equilibrium, the run goes on from there"));

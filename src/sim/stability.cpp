@@ -9,6 +9,8 @@
 #include <random>
 #include <vector>
 
+#include <Eigen/Dense>
+
 #include "core/types.hpp"
 #include "sim/simulation.hpp"
 
@@ -104,6 +106,143 @@ std::int64_t integrate(Simulation& sim, double t0, double T, Trace& trace) {
   return steps;
 }
 
+
+// E of a rod does not change when every triad turns by the same angle about its own d3 (the
+// body frame's strains turn about their third axis) iff bending, shear and the intrinsic
+// curvature are isotropic in the cross-section plane at every link.
+bool spin_invariant(const rod::RodParams& r) {
+  auto iso = [](const Vec3& a, const Vec3& b) {
+    return a.x() == a.y() && b.x() == b.y();
+  };
+  if (!iso(r.a, r.b) || r.omega0.x() != 0 || r.omega0.y() != 0) return false;
+  for (std::size_t k = 0; k < r.a_k.size(); ++k)
+    if (!iso(r.a_k[k], r.b_k[k])) return false;
+  for (const Vec3& w : r.omega0_k)
+    if (w.x() != 0 || w.y() != 0) return false;
+  return true;
+}
+
+// The Hessian method (see the header): fills o's hessian fields and min_difference_kT, and
+// leaves sim at the state kicked along the softest mode when unstable.
+void hessian_probe(Simulation& sim, const StabilityProbe& p, ProbeOutcome& o) {
+  o.hessian = true;
+  const double kT = sim.params().kT;
+  integrate::System& sys = sim.system();
+  const rod::RodState s = sim.rod();
+  const int n = s.size(), N = 6 * n;
+  const double ell = sim.rods().front().ds;  // rotations × ℓ: Å
+  const double dx = 1e-3;                    // Å, and dx/ℓ rad
+  sys.compute_forces(s);
+  double g2 = 0;
+  for (int k = 0; k < n; ++k)
+    g2 += sys.forces()[std::size_t(k)].squaredNorm() +
+          (sys.torques()[std::size_t(k)] / ell).squaredNorm();
+  o.gradient_kT_per_A = std::sqrt(g2) / kT;
+  Eigen::MatrixXd H(N, N);
+  rod::RodState q = s;
+  std::vector<Vec3> Fa, Ta;
+  for (int j = 0; j < N; ++j) {
+    const int k = j / 6, d = j % 6;
+    for (int side = 0; side < 2; ++side) {
+      const double e = side == 0 ? dx : -dx;
+      if (d < 3)
+        q.X[std::size_t(k)][d] = s.X[std::size_t(k)][d] + e;
+      else
+        q.D[std::size_t(k)] = rotation((e / ell) * Vec3::Unit(d - 3)) * s.D[std::size_t(k)];
+      sys.compute_forces(q);
+      if (side == 0) {
+        Fa = sys.forces();
+        Ta = sys.torques();
+        continue;
+      }
+      const std::vector<Vec3>& Fb = sys.forces();
+      const std::vector<Vec3>& Tb = sys.torques();
+      for (int i = 0; i < n; ++i)
+        for (int r = 0; r < 3; ++r) {
+          H(6 * i + r, j) = -(Fa[std::size_t(i)][r] - Fb[std::size_t(i)][r]) / (2 * dx * kT);
+          H(6 * i + 3 + r, j) = -(Ta[std::size_t(i)][r] - Tb[std::size_t(i)][r]) / (2 * dx * ell * kT);
+        }
+    }
+    q.X[std::size_t(k)] = s.X[std::size_t(k)];
+    q.D[std::size_t(k)] = s.D[std::size_t(k)];
+  }
+  sys.compute_forces(s);  // leave the system's loads at the state, as a step would
+  o.asymmetry = (H - H.transpose()).norm() / std::max(H.norm(), 1e-300);
+  // the zero modes: translations, rotations about the centroid, each spin-invariant rod's spin
+  std::vector<Eigen::VectorXd> zero;
+  Vec3 c = Vec3::Zero();
+  for (const Vec3& x : s.X) c += x;
+  c /= double(n);
+  for (int a = 0; a < 3; ++a) {
+    Eigen::VectorXd t = Eigen::VectorXd::Zero(N), w = Eigen::VectorXd::Zero(N);
+    for (int k = 0; k < n; ++k) {
+      t(6 * k + a) = 1;
+      w.segment<3>(6 * k) = Vec3::Unit(a).cross(s.X[std::size_t(k)] - c);
+      w(6 * k + 3 + a) = ell;
+    }
+    zero.push_back(t);
+    zero.push_back(w);
+  }
+  for (std::size_t r = 0; r < sim.rods().size(); ++r) {
+    if (!spin_invariant(sim.rods()[r])) continue;
+    const rod::RodRange& g = sim.rod_ranges()[r];
+    Eigen::VectorXd v = Eigen::VectorXd::Zero(N);
+    for (int k = g.offset; k < g.offset + g.n; ++k)
+      v.segment<3>(6 * k + 3) = ell * s.D[std::size_t(k)].col(2);
+    zero.push_back(v);
+  }
+  Eigen::MatrixXd Z(N, Eigen::Index(zero.size()));
+  for (std::size_t i = 0; i < zero.size(); ++i) Z.col(Eigen::Index(i)) = zero[i];
+  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(Z);
+  const Eigen::MatrixXd Q = qr.householderQ() * Eigen::MatrixXd::Identity(N, Z.cols());
+  o.zero_modes = int(Z.cols());
+  // P Hs P with P = I − Q Qᵀ: the zero modes get eigenvalue 0 exactly, which the count skips
+  Eigen::MatrixXd Hs = 0.5 * (H + H.transpose());
+  H.resize(0, 0);
+  const Eigen::MatrixXd HQ = Hs * Q;
+  Hs -= HQ * Q.transpose() + Q * HQ.transpose();
+  Hs += Q * (Q.transpose() * HQ) * Q.transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Hs);
+  // the zero modes sit at 0 among the others: drop the o.zero_modes eigenvalues nearest 0 whose
+  // vectors lie in span(Q)
+  std::vector<int> keep;
+  for (int i = 0; i < N; ++i)
+    if ((Q.transpose() * eig.eigenvectors().col(i)).norm() < 0.5) keep.push_back(i);
+  const double tol = p.tolerance / kT;
+  const int first = keep.front();
+  for (std::size_t i = 0; i < keep.size() && o.lowest_eigenvalues.size() < 8; ++i)
+    o.lowest_eigenvalues.push_back(eig.eigenvalues()[keep[i]]);
+  auto kick_energy = [&](int i, double& scale) {
+    const Eigen::VectorXd v = eig.eigenvectors().col(i);
+    double vmax = 0;
+    for (int k = 0; k < n; ++k) vmax = std::max(vmax, v.segment<6>(6 * k).norm());
+    scale = p.kick / vmax;
+    return 0.5 * eig.eigenvalues()[i] * scale * scale;
+  };
+  for (int i : keep) {
+    double sc;
+    if (eig.eigenvalues()[i] >= 0) break;
+    if (kick_energy(i, sc) < -tol) ++o.negative_modes;
+  }
+  double scale = 0;
+  o.min_difference_kT = kick_energy(first, scale);
+  o.stable = !(o.min_difference_kT < -tol);
+  o.E_continuation_kT = o.E_after_kT = o.E_before_kT;
+  o.writhe_continuation = o.writhe_after = o.writhe_before;
+  if (o.stable) return;
+  // unstable: the run goes on from the state kicked along the softest mode
+  const Eigen::VectorXd v = scale * eig.eigenvectors().col(first);
+  rod::RodState kicked = s;
+  for (int k = 0; k < n; ++k) {
+    kicked.X[std::size_t(k)] += v.segment<3>(6 * k);
+    kicked.D[std::size_t(k)] = rotation(v.segment<3>(6 * k + 3) / ell) * s.D[std::size_t(k)];
+  }
+  sim.set_rod_state(std::move(kicked), "the stability test's kick");
+  const Observables after = sim.observe();
+  o.E_after_kT = after.E_total_kT;
+  o.writhe_after = after.writhe;
+}
+
 }  // namespace
 
 ProbeOutcome probe_stability(Simulation& sim, const StabilityProbe& p, std::uint64_t index) {
@@ -114,6 +253,10 @@ ProbeOutcome probe_stability(Simulation& sim, const StabilityProbe& p, std::uint
   const Observables before = sim.observe();
   o.E_before_kT = before.E_total_kT;
   o.writhe_before = before.writhe;
+  if (p.method == StabilityProbe::Method::hessian) {
+    hessian_probe(sim, p, o);
+    return o;
+  }
 
   // 1. save: the whole dynamical state (Simulation::snapshot, as a checkpoint keeps it)
   const Snapshot saved = sim.snapshot();
@@ -159,6 +302,18 @@ ProbeOutcome probe_stability(Simulation& sim, const StabilityProbe& p, std::uint
 
 std::string describe(const ProbeOutcome& o) {
   char buf[400];
+  if (o.hessian) {
+    std::snprintf(buf, sizeof buf,
+                  "%s (Hessian): lowest eigenvalue %.3g kT/A^2 less %d zero modes (next %.3g); "
+                  "a %s kick along its mode changes E_total by %+.3g kT; %d negative modes; "
+                  "|grad E| %.3g kT/A, asymmetry %.2g; from t = %.4f us",
+                  o.stable ? "stable" : "unstable",
+                  o.lowest_eigenvalues.empty() ? 0.0 : o.lowest_eigenvalues[0], o.zero_modes,
+                  o.lowest_eigenvalues.size() > 1 ? o.lowest_eigenvalues[1] : 0.0,
+                  "time.stability_kick_A", o.min_difference_kT, o.negative_modes,
+                  o.gradient_kT_per_A, o.asymmetry, o.time_us);
+    return buf;
+  }
   std::snprintf(buf, sizeof buf,
                 "%s: the kicked copy's E_total minus the unperturbed continuation's: lowest %+.3g "
                 "kT (%.4g us after the kick), %+.3g kT at the end (%.4g us; continuation %.9g kT, "

@@ -40,14 +40,36 @@
 // it only through the twist–writhe coupling (docs/study.md measures both). The test is serial-only
 // (a distributed fluid would have to be gathered to be saved); deterministic, so a resumed run
 // probes alike.
+//
+// The Hessian method (time.stability_method = "hessian"). The dynamic test misses a slowly
+// unstable state whose stable modes relax slowly too: on the reference ΔLk = 2 circle (600 bp,
+// 0.1 M) with dynamics that follow the explicit scheme's, the kicked copy stays +5e-4 kT above the
+// continuation after 2 µs and +1e-4 kT after 6 µs, so the unstable circle is called stable
+// (docs/study.md). For overdamped dynamics q̇ = −M ∇E, M symmetric positive definite, −M H has as
+// many growing modes as H has negative eigenvalues (Sylvester's law of inertia), whatever M is.
+// So: H = −∂(F, T)/∂(X, ℓθ) by central differences of System::compute_forces (every term: elastic,
+// electrostatic, steric, external; θ the space-frame rotation vector of a triad, ℓ = the first
+// rod's Δs puts rotations in Å), symmetrised; the six rigid-body modes and, for each rod with
+// isotropic bending, the uniform spin of its triads about their tangents (zero modes of E) are
+// projected out; λ₁ is its lowest other eigenvalue, v₁ its unit vector. A kick of amplitude a
+// along v₁ (scaled so that the largest point's (δX, ℓδθ) has length a) changes the energy by
+// ½ λ₁ s², s = a / max_k |v₁,k|: unstable if that is below −tolerance, and then the run goes on
+// from the state kicked so (the test takes no simulated time). Cost: 2 × 6n force evaluations
+// and a dense eigensolve (~15 s of one core at 600 points), at most kMaxHessianPoints points.
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace ibrod::sim {
 
 class Simulation;
 
 struct StabilityProbe {
+  /// dynamic: the two copies above. hessian: the lowest eigenvalue of the total energy's Hessian
+  /// (the Hessian method above).
+  enum class Method { dynamic, hessian };
+  static constexpr int kMaxHessianPoints = 1500;  ///< dense: (6n)² doubles, O((6n)³) eigenvalues
+  Method method = Method::dynamic;
   bool enabled = true;
   double amplitude = 0.05;  ///< A, rad (the twist kick)
   double kick = 1.0;        ///< a, Å (the out-of-plane kick of the positions)
@@ -69,6 +91,14 @@ struct ProbeOutcome {
   /// the lowest E₁(τ) − E_c(τ) over the probe (kT; sampled 100 times, E_c interpolated to the
   /// kicked copy's sample times) and when (µs after the kick)
   double min_difference_kT = 0, min_difference_after_us = 0;
+  // hessian: min_difference_kT is ½ λ₁ s², the energy a kick of amplitude a along the softest
+  // mode changes by (s: its length when its largest point moves by a); steps and durations 0
+  bool hessian = false;
+  std::vector<double> lowest_eigenvalues;  ///< the lowest of H less the rigid modes, kT/Å²
+  int negative_modes = 0;                  ///< eigenvalues whose kick lowers E by > tolerance
+  int zero_modes = 0;                      ///< rigid-body (and spin) modes projected out
+  double gradient_kT_per_A = 0;            ///< |∇E| at the state (rotations per length ℓ)
+  double asymmetry = 0;                    ///< ‖H − Hᵀ‖/‖H‖ before symmetrising
 };
 
 /// Runs the probe on `sim` (see the file comment); `index` counts the probes of the run (seed +

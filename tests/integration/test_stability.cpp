@@ -10,9 +10,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <fstream>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "config/config.hpp"
 #include "helpers.hpp"
@@ -184,5 +186,78 @@ TEST(StabilityTest, AnImplicitRunComesToRestInAContactStateAsAVerifiedEquilibriu
   // a gradient flow: E_total never rises from one row to the next
   const std::span<const double> E = t.column("E_total_kT");
   for (std::size_t i = 1; i < E.size(); ++i) EXPECT_LE(E[i], E[i - 1] + 1e-6) << "row " << i;
+  fs::remove_all(d);
+}
+
+// The Hessian method (time.stability_method = "hessian", sim/stability.hpp): the twisted circle
+// above the threshold has a negative eigenvalue (a pair: the m = 2 writhing mode's two phases)
+// once the rigid-body modes and the triads' uniform spin (7 zero modes) are projected out; the
+// run goes on from the circle kicked along it and buckles. Below the threshold the lowest
+// eigenvalue is positive and the run stops as a verified equilibrium at the tested state.
+TEST(StabilityHessian, TheUnstableCircleHasANegativeModeAndTheStableOneNone) {
+  const fs::path d = fresh_dir("stability_hessian");
+  const std::vector<std::string> hessian{"--set", "time.stability_method=\"hessian\""};
+  auto run = [&](int dlk, const std::string& name) {
+    std::vector<std::string> args{"run", circle_config(d, dlk).string(), "-o", (d / name).string()};
+    args.insert(args.end(), hessian.begin(), hessian.end());
+    const Exit e = run_ibrod(args, d / (name + ".log"));
+    EXPECT_EQ(e.code, 0) << e.output;
+    return nlohmann::json::parse(read_file(d / name / "summary.json"));
+  };
+  const auto up = run(3, "dlk3");
+  ASSERT_FALSE(up["stability_tests"].empty());
+  const auto t3 = up["stability_tests"][0];
+  EXPECT_EQ(t3["method"], "hessian");
+  EXPECT_FALSE(t3["stable"].get<bool>()) << t3.dump();
+  EXPECT_EQ(t3["zero_modes"].get<int>(), 7);
+  EXPECT_GE(t3["negative_modes"].get<int>(), 2) << t3.dump();
+  const auto ev3 = t3["lowest_eigenvalues_kT_per_A2"].get<std::vector<double>>();
+  ASSERT_GE(ev3.size(), 2u);
+  EXPECT_LT(ev3[0], 0);
+  EXPECT_NEAR(ev3[1], ev3[0], 0.05 * std::abs(ev3[0]));  // the pair of phases
+  EXPECT_LT(t3["E_difference_min_kT"].get<double>(), -1e-6);
+  EXPECT_LT(t3["hessian_asymmetry"].get<double>(), 1e-2);
+  EXPECT_NE(up["stop_reason"], "equilibrium");
+  EXPECT_GT(final_writhe(d / "dlk3"), 0.5);
+  // after k unstable verdicts in a row the next waits 2^(k−1) probe times (0.2 µs)
+  const auto& tests = up["stability_tests"];
+  for (std::size_t k = 1; k < tests.size(); ++k)
+    EXPECT_GE(tests[k]["time_us"].get<double>() - tests[k - 1]["time_us"].get<double>(),
+              0.2 * std::ldexp(1.0, int(k) - 1) - 1e-9)
+        << tests.dump();
+
+  const auto down = run(1, "dlk1");
+  EXPECT_EQ(down["stop_reason"], "equilibrium");
+  EXPECT_TRUE(down["equilibrium_verified"].get<bool>());
+  const auto t1 = down["stability_tests"][0];
+  EXPECT_TRUE(t1["stable"].get<bool>()) << t1.dump();
+  EXPECT_EQ(t1["negative_modes"].get<int>(), 0);
+  EXPECT_GT(t1["lowest_eigenvalues_kT_per_A2"][0].get<double>(), 0) << t1.dump();
+  const io::CsvTable t = io::read_csv_table(d / "dlk1" / "timeseries.csv");
+  EXPECT_NEAR(t.column("E_total_kT").back(), t1["E_total_before_kT"].get<double>(), 1e-9);
+  fs::remove_all(d);
+}
+
+// A toroid at rest with its strands in contact (the implicit contact run above): no negative
+// mode through the hard core; a verified equilibrium.
+TEST(StabilityHessian, AContactStateAtRestHasNoNegativeMode) {
+  const fs::path d = fresh_dir("stability_hessian_contact");
+  config::Config c = stop_rule_config(4, 1e-7, 0.5);
+  c.time_scheme = "implicit";
+  c.time_implicit_order = 2;
+  c.time_implicit_local_mobility = "overlap";
+  c.time_dt_ns = 4.4;
+  c.time_t_end_us = 10;
+  c.output_every_us = 0.1;
+  c.time_stability_method = "hessian";
+  const fs::path cfg = write_config(d, c, "contact.toml");
+  const Exit e = run_ibrod({"run", cfg.string(), "-o", (d / "out").string()}, d / "out.log");
+  ASSERT_EQ(e.code, 0) << e.output;
+  const auto s = nlohmann::json::parse(read_file(d / "out" / "summary.json"));
+  EXPECT_EQ(s["stop_reason"], "equilibrium");
+  EXPECT_TRUE(s["equilibrium_verified"].get<bool>());
+  const auto t = s["stability_tests"].back();
+  EXPECT_EQ(t["negative_modes"].get<int>(), 0) << t.dump();
+  EXPECT_GT(s["final"]["E_steric_kT"].get<double>(), 0.0);
   fs::remove_all(d);
 }

@@ -144,3 +144,35 @@ TEST(SchemeKeys, OrderTwoAndItsErrorToleranceReachTheParameters) {
   config::apply_override(c, "time.implicit_krylov_iterations=0");
   EXPECT_THROW(config::apply_override(c, "time.implicit_order=3"), std::exception);
 }
+
+// time.stability_method (docs/config.md "The stability test"): "dynamic" (the default) or
+// "hessian"; anything else, and the dense Hessian on more than 1500 points, is refused naming the
+// key, the value and what is allowed.
+TEST(SchemeKeys, TheStabilityMethodIsDynamicOrHessianAndTheHessianHasASizeLimit) {
+  config::Config c;
+  EXPECT_EQ(config::to_params(c).stability.method, sim::StabilityProbe::Method::dynamic);
+  config::apply_override(c, "time.stability_method=\"hessian\"");
+  EXPECT_EQ(config::to_params(c).stability.method, sim::StabilityProbe::Method::hessian);
+  EXPECT_THAT(config::describe(c), HasSubstr("time.stability_method = \"hessian\""));
+  for (const char* bad : {"\"lanczos\"", "1", "true"}) {
+    try {
+      config::apply_override(c, std::string("time.stability_method=") + bad);
+      FAIL() << "accepted " << bad;
+    } catch (const ConfigError& e) {
+      EXPECT_THAT(e.what(), HasSubstr("time.stability_method")) << bad;
+      EXPECT_THAT(e.what(), HasSubstr("\"dynamic\" or \"hessian\"")) << bad;
+    }
+  }
+  config::apply_override(c, "rod.base_pairs=2000");
+  config::apply_override(c, "grid.box_A=2400");
+  try {
+    config::to_params(c);
+    FAIL() << "the Hessian on 2000 points was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("time.stability_method"));
+    EXPECT_THAT(e.what(), HasSubstr("1500"));
+    EXPECT_THAT(e.what(), HasSubstr("2000"));
+  }
+  config::apply_override(c, "time.stability_test=false");  // no test: no Hessian to refuse
+  EXPECT_NO_THROW(config::to_params(c));
+}
