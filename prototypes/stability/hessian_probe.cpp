@@ -101,6 +101,13 @@ int main(int argc, char** argv) {
   }
   auto t1 = std::chrono::steady_clock::now();
   const double asym = (H - H.transpose()).norm() / H.norm();
+  {  // the Rayleigh quotient of the triads' uniform spin about d3 (an exact invariance of an
+     // isotropic rod, so 0 for the Hessian of E along it)
+    Eigen::VectorXd v = Eigen::VectorXd::Zero(N);
+    for (int k = 0; k < n; ++k) v.segment<3>(6 * k + 3) = ell * s.D[k].col(2);
+    v.normalize();
+    std::printf("spin: v^T H v = %.4e kT/A^2 (symmetric part)\n", v.dot(H * v));
+  }
   Eigen::MatrixXd Hs = 0.5 * (H + H.transpose());
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(
       Hs, vectors ? Eigen::ComputeEigenvectors : Eigen::EigenvaluesOnly);

@@ -51,7 +51,9 @@
 // electrostatic, steric, external; θ the space-frame rotation vector of a triad, ℓ = the first
 // rod's Δs puts rotations in Å), symmetrised; the six rigid-body modes and, for each rod with
 // isotropic bending, the uniform spin of its triads about their tangents (zero modes of E) are
-// projected out; λ₁ is its lowest other eigenvalue, v₁ its unit vector. A kick of amplitude a
+// projected out (exactly: at a state that is not quite critical an invariance couples to the
+// other modes through the gradient, H ξ = −(Dξ)ᵀ∇E, and the unprojected H of a toroid has a
+// spurious negative eigenvalue); λ₁ is its lowest other eigenvalue, v₁ its unit vector. A kick of amplitude a
 // along v₁ (scaled so that the largest point's (δX, ℓδθ) has length a) changes the energy by
 // ½ λ₁ s², s = a / max_k |v₁,k|: unstable if that is below −tolerance, and then the run goes on
 // from the state kicked so (the test takes no simulated time). Cost: 2 × 6n force evaluations
