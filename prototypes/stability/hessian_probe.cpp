@@ -11,12 +11,11 @@
 #include <Eigen/Dense>
 #include <chrono>
 #include <cstdio>
-#include <fstream>
-#include <sstream>
 #include <string>
 
 #include "config/config.hpp"
 #include "integrate/stepper.hpp"
+#include "io/rod_shape.hpp"
 #include "rod/rod.hpp"
 #include "sim/simulation.hpp"
 
@@ -45,22 +44,7 @@ int main(int argc, char** argv) {
       config::apply_override(cfg, a);
   }
   sim::SimParams p = config::to_params(cfg);
-  rod::RodState s = sim::initial_state(p);
-  {
-    std::ifstream in(argv[2]);
-    std::string line;
-    std::getline(in, line);
-    for (int k = 0; k < s.size(); ++k) {
-      std::getline(in, line);
-      for (char& ch : line)
-        if (ch == ',') ch = ' ';
-      std::istringstream is(line);
-      double v[12];
-      for (double& x : v) is >> x;
-      s.X[k] = Vec3(v[0], v[1], v[2]);
-      for (int c = 0; c < 3; ++c) s.D[k].col(c) = Vec3(v[3 + 3 * c], v[4 + 3 * c], v[5 + 3 * c]);
-    }
-  }
+  const rod::RodState s = io::read_rod_shape(argv[2], "STATE.csv");
   if (ell <= 0) ell = p.stepper.rods[0].ds;
   integrate::Stepper st(p.stepper);
   integrate::System& sys = st.system();
