@@ -41,7 +41,9 @@ struct Config {
   double time_stability_probe_us = 2.0;        ///< how long both copies are integrated, µs
   double time_stability_tolerance_kT = 1e-6;   ///< kicked below continuation by more: unstable, kT
   std::int64_t time_stability_seed = 1;        ///< seed of the test's perturbation
-  std::string time_stability_method = "dynamic";  ///< "dynamic" (two copies) or "hessian"
+  /// "auto" ("hessian" up to StabilityProbe::kAutoHessianPoints rod points, else "dynamic"),
+  /// "dynamic" (two copies) or "hessian"
+  std::string time_stability_method = "auto";
   std::string time_scheme = "explicit";        ///< time.scheme: "explicit" | "implicit" (issue 14)
   double time_max_displacement_A = 0;       ///< implicit: largest point move per step, Å (0: auto)
   double time_energy_tolerance_kT = 1e-6;   ///< implicit: allowed energy rise per step, kT

@@ -354,12 +354,18 @@ sim::SimParams to_params(const Config& c) {
   p.stability.time = c.time_stability_probe_us * us;
   p.stability.tolerance = c.time_stability_tolerance_kT * p.kT;
   p.stability.seed = std::uint64_t(c.time_stability_seed);
-  p.stability.method = c.time_stability_method == "hessian" ? sim::StabilityProbe::Method::hessian
-                                                            : sim::StabilityProbe::Method::dynamic;
-  if (c.time_stability_test && p.stability.method == sim::StabilityProbe::Method::hessian) {
+  {
     int points = 0;
     for (const rod::RodParams& r : s.rods) points += r.n;
-    if (points > sim::StabilityProbe::kMaxHessianPoints)
+    // "auto": the Hessian where it is affordable (it finds the slow instabilities the dynamic
+    // test misses, docs/config.md "The stability test"), the two copies above
+    const bool hessian =
+        c.time_stability_method == "hessian" ||
+        (c.time_stability_method == "auto" && points <= sim::StabilityProbe::kAutoHessianPoints);
+    p.stability.method =
+        hessian ? sim::StabilityProbe::Method::hessian : sim::StabilityProbe::Method::dynamic;
+    if (c.time_stability_test && c.time_stability_method == "hessian" &&
+        points > sim::StabilityProbe::kMaxHessianPoints)
       bad("time.stability_method", "\"hessian\"",
           "\"dynamic\" for more than " + std::to_string(sim::StabilityProbe::kMaxHessianPoints) +
               " rod points (the run has " + std::to_string(points) +

@@ -213,20 +213,21 @@ Key scheme_key() {
   return k;
 }
 
-// time.stability_method: "dynamic" or "hessian" (the stability test, docs/config.md)
+// time.stability_method: "auto", "dynamic" or "hessian" (the stability test, docs/config.md)
 Key stability_method_key() {
   Key k;
   k.name = "time.stability_method";
   k.help =
       "how the stability test decides: \"dynamic\" (integrate a kicked copy and the "
-      "unperturbed one for time.stability_probe_us and compare their energies) or \"hessian\" "
+      "unperturbed one for time.stability_probe_us and compare their energies), \"hessian\" "
       "(the lowest eigenvalue of the total energy's Hessian, less the rigid-body modes: "
       "unstable if a kick of time.stability_kick_A along its mode lowers the energy by more "
-      "than time.stability_tolerance_kT; dense, at most 1500 points; docs/config.md)";
+      "than time.stability_tolerance_kT; dense, at most 1500 points) or \"auto\" (\"hessian\" "
+      "up to 1000 rod points, \"dynamic\" above; docs/config.md)";
   k.set = [](Config& c, const toml::node& n) {
     const auto v = n.value_exact<std::string>();
-    if (!v || (*v != "dynamic" && *v != "hessian"))
-      bad("time.stability_method", show(n), "\"dynamic\" or \"hessian\"");
+    if (!v || (*v != "auto" && *v != "dynamic" && *v != "hessian"))
+      bad("time.stability_method", show(n), "\"auto\", \"dynamic\" or \"hessian\"");
     c.time_stability_method = *v;
   };
   k.put = [](const Config& c, toml::table& t) {

@@ -249,6 +249,7 @@ dt_ns = 2.0
 t_end_us = {t_end}
 stop_kinetic_kT = 1e-8
 stability_probe_us = 0.2
+stability_method = "dynamic"   # the probe_time_us check below is the dynamic test's
 [rod]
 base_pairs = 100
 excess_link = {dlk}

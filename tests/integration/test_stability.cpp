@@ -29,9 +29,11 @@ namespace {
 
 // small_config with the equilibrium rule at stop_kT, a probe of probe_us, rows every 100 steps
 // (rows in simulated time for the implicit scheme: set output_every_us), no frames or periodic
-// checkpoints, one thread
+// checkpoints, one thread; the dynamic test (the default, "auto", takes the Hessian at this size:
+// its tests are below)
 config::Config stop_rule_config(int excess_link, double stop_kT, double probe_us) {
   config::Config c = small_config(excess_link);
+  c.time_stability_method = "dynamic";
   c.time_stop_kinetic_kT = stop_kT;
   c.time_stability_probe_us = probe_us;
   c.output_every_steps = 100;

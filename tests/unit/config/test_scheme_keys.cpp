@@ -145,14 +145,24 @@ TEST(SchemeKeys, OrderTwoAndItsErrorToleranceReachTheParameters) {
   EXPECT_THROW(config::apply_override(c, "time.implicit_order=3"), std::exception);
 }
 
-// time.stability_method (docs/config.md "The stability test"): "dynamic" (the default) or
-// "hessian"; anything else, and the dense Hessian on more than 1500 points, is refused naming the
-// key, the value and what is allowed.
-TEST(SchemeKeys, TheStabilityMethodIsDynamicOrHessianAndTheHessianHasASizeLimit) {
+// time.stability_method (docs/config.md "The stability test"): "auto" (the default: the Hessian up
+// to 1000 rod points, the dynamic test above), "dynamic" or "hessian"; anything else, and the
+// dense Hessian asked for on more than 1500 points, is refused naming the key, the value and what
+// is allowed.
+TEST(SchemeKeys, TheStabilityMethodIsAutoDynamicOrHessianAndTheHessianHasASizeLimit) {
   config::Config c;
-  EXPECT_EQ(config::to_params(c).stability.method, sim::StabilityProbe::Method::dynamic);
+  EXPECT_THAT(config::describe(c), HasSubstr("time.stability_method = \"auto\""));
+  using M = sim::StabilityProbe::Method;
+  EXPECT_EQ(config::to_params(c).stability.method, M::hessian);  // the 600-point reference ring
+  config::apply_override(c, "rod.base_pairs=1000");
+  EXPECT_EQ(config::to_params(c).stability.method, M::hessian);
+  config::apply_override(c, "rod.base_pairs=1001");
+  EXPECT_EQ(config::to_params(c).stability.method, M::dynamic);
+  config::apply_override(c, "rod.base_pairs=600");
+  config::apply_override(c, "time.stability_method=\"dynamic\"");
+  EXPECT_EQ(config::to_params(c).stability.method, M::dynamic);
   config::apply_override(c, "time.stability_method=\"hessian\"");
-  EXPECT_EQ(config::to_params(c).stability.method, sim::StabilityProbe::Method::hessian);
+  EXPECT_EQ(config::to_params(c).stability.method, M::hessian);
   EXPECT_THAT(config::describe(c), HasSubstr("time.stability_method = \"hessian\""));
   for (const char* bad : {"\"lanczos\"", "1", "true"}) {
     try {
@@ -160,7 +170,7 @@ TEST(SchemeKeys, TheStabilityMethodIsDynamicOrHessianAndTheHessianHasASizeLimit)
       FAIL() << "accepted " << bad;
     } catch (const ConfigError& e) {
       EXPECT_THAT(e.what(), HasSubstr("time.stability_method")) << bad;
-      EXPECT_THAT(e.what(), HasSubstr("\"dynamic\" or \"hessian\"")) << bad;
+      EXPECT_THAT(e.what(), HasSubstr("\"auto\", \"dynamic\" or \"hessian\"")) << bad;
     }
   }
   config::apply_override(c, "rod.base_pairs=2000");
@@ -173,6 +183,9 @@ TEST(SchemeKeys, TheStabilityMethodIsDynamicOrHessianAndTheHessianHasASizeLimit)
     EXPECT_THAT(e.what(), HasSubstr("1500"));
     EXPECT_THAT(e.what(), HasSubstr("2000"));
   }
+  config::apply_override(c, "time.stability_method=\"auto\"");  // auto: the dynamic test there
+  EXPECT_EQ(config::to_params(c).stability.method, M::dynamic);
+  config::apply_override(c, "time.stability_method=\"hessian\"");
   config::apply_override(c, "time.stability_test=false");  // no test: no Hessian to refuse
   EXPECT_NO_THROW(config::to_params(c));
 }
