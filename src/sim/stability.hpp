@@ -72,7 +72,7 @@ struct StabilityProbe {
   enum class Method { dynamic, hessian };
   static constexpr int kMaxHessianPoints = 1500;  ///< dense: (6n)² doubles, O((6n)³) eigenvalues
   /// time.stability_method = "auto" takes the Hessian up to this many rod points (the 600-point
-  /// reference ring: ~1 min a test on one core; the cost grows as n³)
+  /// reference ring: 1–1.5 min a test on one core; the cost grows as n³)
   static constexpr int kAutoHessianPoints = 1000;
   Method method = Method::dynamic;
   bool enabled = true;
