@@ -7,7 +7,9 @@
 // H = −∂(F, T)/∂(X, ℓθ) by central differences of System::compute_forces (every term: elastic,
 // electrostatic, steric, external), θ the space-frame rotation vector of each triad, ℓ a length
 // that puts rotations in Å (the count of negative eigenvalues does not depend on it); symmetrised.
-//   hessian_probe CONFIG STATE.csv [key=value ...] [ell=ΔS] [dx=1e-3] [k=12]
+//   hessian_probe CONFIG STATE.csv [key=value ...] [ell=ΔS] [dx=1e-3] [k=12] [ibrod=1]
+// (ibrod=1: ibrod's own test at the state instead, sim::probe_stability with the Hessian method:
+// rigid modes, spin and slithering projected out). STATE: a final_state.csv or H5MD@FRAME.
 #include <Eigen/Dense>
 #include <chrono>
 #include <cstdio>
@@ -18,6 +20,7 @@
 #include "io/rod_shape.hpp"
 #include "rod/rod.hpp"
 #include "sim/simulation.hpp"
+#include "sim/stability.hpp"
 
 using namespace ibrod;
 
@@ -29,7 +32,7 @@ int main(int argc, char** argv) {
   config::Config cfg = config::load_config(argv[1]);
   double ell = -1, dx = 1e-3;
   int k_print = 12;
-  bool vectors = true;
+  bool vectors = true, ibrod_test = false;
   for (int i = 3; i < argc; ++i) {
     const std::string a = argv[i];
     if (a.rfind("ell=", 0) == 0)
@@ -40,12 +43,24 @@ int main(int argc, char** argv) {
       vectors = a.substr(8) != "0";
     else if (a.rfind("k=", 0) == 0)
       k_print = std::stoi(a.substr(2));
+    else if (a.rfind("ibrod=", 0) == 0)
+      ibrod_test = a.substr(6) != "0";
     else
       config::apply_override(cfg, a);
   }
   sim::SimParams p = config::to_params(cfg);
   const rod::RodState s = io::read_rod_shape(argv[2], "STATE.csv");
   if (ell <= 0) ell = p.stepper.rods[0].ds;
+  if (ibrod_test) {  // ibrod's own test (sim::probe_stability, the Hessian method) at the state
+    p.stability.method = sim::StabilityProbe::Method::hessian;
+    sim::Simulation sim(p);
+    sim.set_rod_state(s, "STATE.csv");
+    const sim::ProbeOutcome o = sim::probe_stability(sim, p.stability, 0);
+    std::printf("%s\nlowest:", sim::describe(o).c_str());
+    for (double e : o.lowest_eigenvalues) std::printf(" %.4e", e);
+    std::printf("\n");
+    return 0;
+  }
   integrate::Stepper st(p.stepper);
   integrate::System& sys = st.system();
   const int n = s.size(), N = 6 * n;
@@ -92,6 +107,23 @@ int main(int argc, char** argv) {
     v.normalize();
     std::printf("spin: v^T H v = %.4e kT/A^2 (symmetric part)\n", v.dot(H * v));
   }
+  // the slithering of a closed rod along its own contour, X(s) → X(s + ε), D(s) → D(s + ε): an
+  // exact invariance of a smooth uniform ring, a near one of the discrete ring. Discretely
+  // δX_k = (X_{k+1} − X_{k−1})/2 and δθ_k the mean of the space-frame rotation vectors taking
+  // D_{k−1} to D_k and D_k to D_{k+1}.
+  Eigen::VectorXd slither = Eigen::VectorXd::Zero(N);
+  for (int k = 0; k < n; ++k) {
+    const int kp = (k + 1) % n, km = (k + n - 1) % n;
+    auto rotvec = [](const Mat3& R) {
+      const Eigen::AngleAxisd aa(R);
+      return Vec3(aa.angle() * aa.axis());
+    };
+    slither.segment<3>(6 * k) = 0.5 * (s.X[kp] - s.X[km]);
+    slither.segment<3>(6 * k + 3) =
+        0.5 * ell * (rotvec(s.D[kp] * s.D[k].transpose()) + rotvec(s.D[k] * s.D[km].transpose()));
+  }
+  slither.normalize();
+  std::printf("slithering: v^T H v = %.4e kT/A^2 (symmetric part)\n", slither.dot(H * slither));
   Eigen::MatrixXd Hs = 0.5 * (H + H.transpose());
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(
       Hs, vectors ? Eigen::ComputeEigenvectors : Eigen::EigenvaluesOnly);
@@ -114,8 +146,8 @@ int main(int argc, char** argv) {
       rough += (v.segment<3>(6 * k1) - v.segment<3>(6 * k)).squaredNorm() +
                (v.segment<3>(6 * k1 + 3) - v.segment<3>(6 * k + 3)).squaredNorm();
     }
-    std::printf("mode %d: %.4e  position share %.3f  roughness %.3e\n", i, eig.eigenvalues()[i],
-                px, rough / (px + prot));
+    std::printf("mode %d: %.4e  position share %.3f  roughness %.3e  overlap with slithering %.3f\n",
+                i, eig.eigenvalues()[i], px, rough / (px + prot), std::abs(v.dot(slither)));
   }
   return 0;
 }

@@ -341,6 +341,7 @@ StopReason Run::State::test_stability(StopReason candidate) {
     t["lowest_eigenvalues_kT_per_A2"] = o.lowest_eigenvalues;
     t["negative_modes"] = o.negative_modes;
     t["zero_modes"] = o.zero_modes;
+    t["slithering_modes"] = o.slithering_modes;
     t["gradient_kT_per_A"] = o.gradient_kT_per_A;
     t["hessian_asymmetry"] = o.asymmetry;
   }

@@ -191,11 +191,26 @@ void hessian_probe(Simulation& sim, const StabilityProbe& p, ProbeOutcome& o) {
       v.segment<3>(6 * k + 3) = ell * s.D[std::size_t(k)].col(2);
     zero.push_back(v);
   }
+  // each uniform closed rod's slithering, where it is not already (nearly) a rigid motion plus
+  // the spin (a circle's is exactly one): the part of it that the modes above leave, if that
+  // keeps more than kSlitherResidual of its length
+  std::vector<Eigen::VectorXd> slither;
+  for (std::size_t r = 0; r < sim.rods().size(); ++r)
+    if (slither_invariant(sim.rods()[r]))
+      slither.push_back(slithering_vector(s, sim.rod_ranges()[r], ell));
   Eigen::MatrixXd Z(N, Eigen::Index(zero.size()));
   for (std::size_t i = 0; i < zero.size(); ++i) Z.col(Eigen::Index(i)) = zero[i];
-  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(Z);
-  const Eigen::MatrixXd Q = qr.householderQ() * Eigen::MatrixXd::Identity(N, Z.cols());
-  o.zero_modes = int(Z.cols());
+  Eigen::MatrixXd Q = Eigen::HouseholderQR<Eigen::MatrixXd>(Z).householderQ() *
+                      Eigen::MatrixXd::Identity(N, Z.cols());
+  for (const Eigen::VectorXd& v : slither) {
+    Eigen::VectorXd w = v - Q * (Q.transpose() * v);
+    w -= Q * (Q.transpose() * w);  // twice is enough
+    if (w.norm() <= StabilityProbe::kSlitherResidual * v.norm()) continue;
+    Q.conservativeResize(Eigen::NoChange, Q.cols() + 1);
+    Q.col(Q.cols() - 1) = w.normalized();
+    ++o.slithering_modes;
+  }
+  o.zero_modes = int(Q.cols());
   // P Hs P with P = I − Q Qᵀ: the zero modes get eigenvalue 0 exactly, which the count skips
   Eigen::MatrixXd Hs = 0.5 * (H + H.transpose());
   H.resize(0, 0);
@@ -304,11 +319,12 @@ std::string describe(const ProbeOutcome& o) {
   char buf[400];
   if (o.hessian) {
     std::snprintf(buf, sizeof buf,
-                  "%s (Hessian): lowest eigenvalue %.3g kT/A^2 less %d zero modes (next %.3g); "
+                  "%s (Hessian): lowest eigenvalue %.3g kT/A^2 less %d zero modes (%d slithering; next %.3g); "
                   "a %s kick along its mode changes E_total by %+.3g kT; %d negative modes; "
                   "|grad E| %.3g kT/A, asymmetry %.2g; from t = %.4f us",
                   o.stable ? "stable" : "unstable",
                   o.lowest_eigenvalues.empty() ? 0.0 : o.lowest_eigenvalues[0], o.zero_modes,
+                  o.slithering_modes,
                   o.lowest_eigenvalues.size() > 1 ? o.lowest_eigenvalues[1] : 0.0,
                   "time.stability_kick_A", o.min_difference_kT, o.negative_modes,
                   o.gradient_kT_per_A, o.asymmetry, o.time_us);
@@ -323,5 +339,32 @@ std::string describe(const ProbeOutcome& o) {
                 o.E_before_kT, o.writhe_before, o.writhe_after, o.writhe_continuation, o.time_us);
   return buf;
 }
+
+bool slither_invariant(const rod::RodParams& r) {
+  if (!r.closed) return false;
+  auto uniform = [](const std::vector<Vec3>& v) {
+    for (const Vec3& x : v)
+      if (x != v.front()) return false;
+    return true;
+  };
+  return uniform(r.a_k) && uniform(r.b_k) && uniform(r.omega0_k);
+}
+
+Eigen::VectorXd slithering_vector(const rod::RodState& s, const rod::RodRange& g, double ell) {
+  auto rotvec = [](const Mat3& R) {
+    const Eigen::AngleAxisd aa(R);
+    return Vec3(aa.angle() * aa.axis());
+  };
+  Eigen::VectorXd v = Eigen::VectorXd::Zero(6 * Eigen::Index(s.size()));
+  for (int i = 0; i < g.n; ++i) {
+    const auto k = std::size_t(g.offset + i), kp = std::size_t(g.offset + (i + 1) % g.n),
+               km = std::size_t(g.offset + (i + g.n - 1) % g.n);
+    v.segment<3>(6 * Eigen::Index(k)) = 0.5 * (s.X[kp] - s.X[km]);
+    v.segment<3>(6 * Eigen::Index(k) + 3) =
+        0.5 * ell * (rotvec(s.D[kp] * s.D[k].transpose()) + rotvec(s.D[k] * s.D[km].transpose()));
+  }
+  return v;
+}
+
 
 }  // namespace ibrod::sim

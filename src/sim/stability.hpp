@@ -53,7 +53,10 @@
 // isotropic bending, the uniform spin of its triads about their tangents (zero modes of E) are
 // projected out (exactly: at a state that is not quite critical an invariance couples to the
 // other modes through the gradient, H ξ = −(Dξ)ᵀ∇E, and the unprojected H of a toroid has a
-// spurious negative eigenvalue); λ₁ is its lowest other eigenvalue, v₁ its unit vector. A kick of amplitude a
+// spurious negative eigenvalue), and so is each uniform closed rod's slithering along its own
+// contour (slithering_vector below: a near-invariance of the discrete ring, left out where the
+// rigid modes and the spin already span it to within kSlitherResidual, as on a circle); λ₁ is
+// its lowest other eigenvalue, v₁ its unit vector. A kick of amplitude a
 // along v₁ (scaled so that the largest point's (δX, ℓδθ) has length a) changes the energy by
 // ½ λ₁ s², s = a / max_k |v₁,k|: unstable if that is below −tolerance, and then the run goes on
 // from the state kicked so (the test takes no simulated time). Cost: 2 × 6n force evaluations
@@ -61,6 +64,11 @@
 #include <cstdint>
 #include <string>
 #include <vector>
+
+#include <Eigen/Core>
+
+#include "rod/rod.hpp"
+#include "rod/rod_set.hpp"
 
 namespace ibrod::sim {
 
@@ -74,6 +82,10 @@ struct StabilityProbe {
   /// time.stability_method = "auto" takes the Hessian up to this many rod points (the 600-point
   /// reference ring: 1–1.5 min a test on one core; the cost grows as n³)
   static constexpr int kAutoHessianPoints = 1000;
+  /// a closed uniform rod's slithering is projected out where the part of it that the rigid modes
+  /// and the spin leave is longer than this fraction of it (a circle's slithering is a rotation
+  /// plus the spin: nothing is left)
+  static constexpr double kSlitherResidual = 0.1;
   Method method = Method::dynamic;
   bool enabled = true;
   double amplitude = 0.05;  ///< A, rad (the twist kick)
@@ -101,7 +113,8 @@ struct ProbeOutcome {
   bool hessian = false;
   std::vector<double> lowest_eigenvalues;  ///< the lowest of H less the rigid modes, kT/Å²
   int negative_modes = 0;                  ///< eigenvalues whose kick lowers E by > tolerance
-  int zero_modes = 0;                      ///< rigid-body (and spin) modes projected out
+  int zero_modes = 0;           ///< modes projected out: rigid-body, spin, slithering
+  int slithering_modes = 0;     ///< of which slithering (one per uniform closed rod, see above)
   double gradient_kT_per_A = 0;            ///< |∇E| at the state (rotations per length ℓ)
   double asymmetry = 0;                    ///< ‖H − Hᵀ‖/‖H‖ before symmetrising
 };
@@ -110,6 +123,18 @@ struct ProbeOutcome {
 /// index draws the perturbation). Leaves sim at the saved state if stable, at the probe's end if
 /// not.
 ProbeOutcome probe_stability(Simulation& sim, const StabilityProbe& p, std::uint64_t index);
+
+/// Whether a closed rod's energy is invariant under the slithering of its material along its own
+/// contour, X(s) → X(s + ε), D(s) → D(s + ε): iff it is closed and uniform (the same moduli and
+/// intrinsic strains at every link). Exact for the smooth rod; for the discrete ring the shift by
+/// one point is the exact symmetry and the slithering below a near one, O(Δs²).
+bool slither_invariant(const rod::RodParams& r);
+
+/// The slithering of the closed rod at points [g.offset, g.offset + g.n) of s, in the Hessian's
+/// coordinates (δX_k, ℓδθ_k) of all s.size() points (zero outside the rod): δX_k = (X_{k+1} −
+/// X_{k−1})/2 and δθ_k the mean of the space-frame rotation vectors taking D_{k−1} to D_k and D_k
+/// to D_{k+1} (indices cyclic within the rod).
+Eigen::VectorXd slithering_vector(const rod::RodState& s, const rod::RodRange& g, double ell);
 
 /// One line for logs: "stable: kicked − continuation = +3.7e-05 kT …" or "unstable: …".
 std::string describe(const ProbeOutcome& o);
