@@ -107,21 +107,10 @@ int main(int argc, char** argv) {
     v.normalize();
     std::printf("spin: v^T H v = %.4e kT/A^2 (symmetric part)\n", v.dot(H * v));
   }
-  // the slithering of a closed rod along its own contour, X(s) → X(s + ε), D(s) → D(s + ε): an
-  // exact invariance of a smooth uniform ring, a near one of the discrete ring. Discretely
-  // δX_k = (X_{k+1} − X_{k−1})/2 and δθ_k the mean of the space-frame rotation vectors taking
-  // D_{k−1} to D_k and D_k to D_{k+1}.
-  Eigen::VectorXd slither = Eigen::VectorXd::Zero(N);
-  for (int k = 0; k < n; ++k) {
-    const int kp = (k + 1) % n, km = (k + n - 1) % n;
-    auto rotvec = [](const Mat3& R) {
-      const Eigen::AngleAxisd aa(R);
-      return Vec3(aa.angle() * aa.axis());
-    };
-    slither.segment<3>(6 * k) = 0.5 * (s.X[kp] - s.X[km]);
-    slither.segment<3>(6 * k + 3) =
-        0.5 * ell * (rotvec(s.D[kp] * s.D[k].transpose()) + rotvec(s.D[k] * s.D[km].transpose()));
-  }
+  // the slithering of the closed rod along its own contour (sim::slithering_vector, the vector
+  // the test projects out)
+  Eigen::VectorXd slither =
+      sim::slithering_vector(s, rod::RodRange{0, n, true, p.stepper.rods[0].ds}, ell);
   slither.normalize();
   std::printf("slithering: v^T H v = %.4e kT/A^2 (symmetric part)\n", slither.dot(H * slither));
   Eigen::MatrixXd Hs = 0.5 * (H + H.transpose());

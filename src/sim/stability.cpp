@@ -191,18 +191,16 @@ void hessian_probe(Simulation& sim, const StabilityProbe& p, ProbeOutcome& o) {
       v.segment<3>(6 * k + 3) = ell * s.D[std::size_t(k)].col(2);
     zero.push_back(v);
   }
-  // each uniform closed rod's slithering, where it is not already (nearly) a rigid motion plus
-  // the spin (a circle's is exactly one): the part of it that the modes above leave, if that
-  // keeps more than kSlitherResidual of its length
-  std::vector<Eigen::VectorXd> slither;
-  for (std::size_t r = 0; r < sim.rods().size(); ++r)
-    if (slither_invariant(sim.rods()[r]))
-      slither.push_back(slithering_vector(s, sim.rod_ranges()[r], ell));
   Eigen::MatrixXd Z(N, Eigen::Index(zero.size()));
   for (std::size_t i = 0; i < zero.size(); ++i) Z.col(Eigen::Index(i)) = zero[i];
   Eigen::MatrixXd Q = Eigen::HouseholderQR<Eigen::MatrixXd>(Z).householderQ() *
                       Eigen::MatrixXd::Identity(N, Z.cols());
-  for (const Eigen::VectorXd& v : slither) {
+  // each uniform closed rod's slithering, where it is not already (nearly) a rigid motion plus
+  // the spin (a circle's is exactly one): the part of it that the modes above leave, if that
+  // keeps more than kSlitherResidual of its length
+  for (std::size_t r = 0; r < sim.rods().size(); ++r) {
+    if (!slither_invariant(sim.rods()[r])) continue;
+    const Eigen::VectorXd v = slithering_vector(s, sim.rod_ranges()[r], ell);
     Eigen::VectorXd w = v - Q * (Q.transpose() * v);
     w -= Q * (Q.transpose() * w);  // twice is enough
     if (w.norm() <= StabilityProbe::kSlitherResidual * v.norm()) continue;
@@ -319,7 +317,8 @@ std::string describe(const ProbeOutcome& o) {
   char buf[400];
   if (o.hessian) {
     std::snprintf(buf, sizeof buf,
-                  "%s (Hessian): lowest eigenvalue %.3g kT/A^2 less %d zero modes (%d slithering; next %.3g); "
+                  "%s (Hessian): lowest eigenvalue %.3g kT/A^2 less %d zero modes (%d slithering; "
+                  "next %.3g); "
                   "a %s kick along its mode changes E_total by %+.3g kT; %d negative modes; "
                   "|grad E| %.3g kT/A, asymmetry %.2g; from t = %.4f us",
                   o.stable ? "stable" : "unstable",
@@ -365,6 +364,5 @@ Eigen::VectorXd slithering_vector(const rod::RodState& s, const rod::RodRange& g
   }
   return v;
 }
-
 
 }  // namespace ibrod::sim

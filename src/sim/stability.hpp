@@ -113,8 +113,8 @@ struct ProbeOutcome {
   bool hessian = false;
   std::vector<double> lowest_eigenvalues;  ///< the lowest of H less the rigid modes, kT/Å²
   int negative_modes = 0;                  ///< eigenvalues whose kick lowers E by > tolerance
-  int zero_modes = 0;           ///< modes projected out: rigid-body, spin, slithering
-  int slithering_modes = 0;     ///< of which slithering (one per uniform closed rod, see above)
+  int zero_modes = 0;                      ///< modes projected out: rigid-body, spin, slithering
+  int slithering_modes = 0;                ///< of which slithering (per uniform closed rod)
   double gradient_kT_per_A = 0;            ///< |∇E| at the state (rotations per length ℓ)
   double asymmetry = 0;                    ///< ‖H − Hᵀ‖/‖H‖ before symmetrising
 };
